@@ -1,0 +1,168 @@
+"""Compiles a :class:`~mtpg.model.Population` into the flat arrays the kernels execute.
+
+The kernels work on one float64 *workspace* per thread:
+
+============================  ==========================================
+``[0, R)``                    private registers ``r``
+``[R, R+18)``                 the constants
+``[R+18, R+18+n_obs)``        the observation
+``[BASE + b*M, BASE+(b+1)*M)`` memory bank ``b`` (dense index), ``BASE = R+18+n_obs``
+============================  ==========================================
+
+Instruction operands are rewritten from the logical layout of
+:mod:`mtpg.model.instructions` to absolute workspace indices, so a program touches its
+memory bank in place with no copying. Introns are dropped here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mtpg.model.graph import Population
+from mtpg.model.instructions import N_CONSTANTS, RegisterLayout, effective_mask
+
+
+@dataclass(frozen=True)
+class CompiledPopulation:
+    """A population as flat arrays.
+
+    Attributes:
+        layout: Register sizes.
+        team_ids: int64 ``[n_teams]``: model team id of each dense team index.
+        team_offsets: int64 ``[n_teams + 1]``: members of team ``t`` are
+            ``team_members[team_offsets[t]:team_offsets[t + 1]]``.
+        team_members: int64: dense program indices, in execution order.
+        program_ids: int64 ``[n_programs]``: model program id of each dense index.
+        prog_offsets: int64 ``[n_programs + 1]``: effective instructions of program ``p``
+            are ``instrs[prog_offsets[p]:prog_offsets[p + 1]]``.
+        instrs: int32 ``[n, 4]``: ``op, dst, src1, src2`` as workspace indices.
+        prog_action: int64 ``[n_programs]``: dense team index, or ``-1 - a`` for atomic
+            action ``a``.
+        prog_bank: int64 ``[n_programs]``: dense memory bank index.
+        bank_ids: int64 ``[n_banks]``: model bank id of each dense bank index.
+        n_instructions: int64 ``[n_programs]``: instructions before intron removal.
+    """
+
+    layout: RegisterLayout
+    team_ids: np.ndarray
+    team_offsets: np.ndarray
+    team_members: np.ndarray
+    program_ids: np.ndarray
+    prog_offsets: np.ndarray
+    instrs: np.ndarray
+    prog_action: np.ndarray
+    prog_bank: np.ndarray
+    bank_ids: np.ndarray
+    n_instructions: np.ndarray
+
+    @property
+    def mem_base(self) -> int:
+        """Workspace index of the first memory register."""
+        return self.layout.n_registers + N_CONSTANTS + self.layout.n_obs
+
+    @property
+    def workspace_size(self) -> int:
+        """Length of a workspace holding every bank."""
+        return self.mem_base + len(self.bank_ids) * self.layout.n_memory
+
+    def team_index(self, team_id: int) -> int:
+        """Dense index of a model team id."""
+        return int(np.searchsorted(self.team_ids, team_id))
+
+    def bank_index(self, bank_id: int) -> int:
+        """Dense index of a model bank id."""
+        return int(np.searchsorted(self.bank_ids, bank_id))
+
+    def kernel_args(self) -> tuple:
+        """The arrays and sizes every kernel takes, in kernel argument order."""
+        return (
+            self.team_offsets,
+            self.team_members,
+            self.prog_offsets,
+            self.instrs,
+            self.prog_action,
+            self.prog_bank,
+            self.layout.n_registers,
+            self.layout.n_memory,
+            self.mem_base,
+        )
+
+
+def workspace_map(layout: RegisterLayout, bank: int, mem_base: int) -> np.ndarray:
+    """Maps logical register indices of a program with dense ``bank`` to workspace indices.
+
+    Args:
+        layout: Register sizes.
+        bank: Dense memory bank index of the program.
+        mem_base: Workspace index of bank 0.
+
+    Returns:
+        int32 array of length ``layout.size``.
+    """
+    r, m = layout.n_registers, layout.n_memory
+    return np.concatenate(
+        [
+            np.arange(r),
+            mem_base + bank * m + np.arange(m),
+            r + np.arange(N_CONSTANTS),
+            r + N_CONSTANTS + np.arange(layout.n_obs),
+        ]
+    ).astype(np.int32)
+
+
+def compile_population(pop: Population, remove_introns: bool = True) -> CompiledPopulation:
+    """Flattens a population for the kernels.
+
+    Args:
+        pop: The population (all teams are compiled; roots are chosen at run time).
+        remove_introns: Drop instructions that affect neither ``r[0]`` nor memory.
+
+    Returns:
+        The compiled population.
+    """
+    layout = pop.layout
+    team_ids = np.array(sorted(pop.teams), dtype=np.int64)
+    program_ids = np.array(sorted(pop.programs), dtype=np.int64)
+    bank_ids = np.array(sorted(pop.banks()), dtype=np.int64)
+    team_pos = {int(t): i for i, t in enumerate(team_ids)}
+    prog_pos = {int(p): i for i, p in enumerate(program_ids)}
+    bank_pos = {int(b): i for i, b in enumerate(bank_ids)}
+    mem_base = layout.n_registers + N_CONSTANTS + layout.n_obs
+
+    members = [prog_pos[pid] for tid in team_ids for pid in pop.teams[int(tid)].programs]
+    sizes = [len(pop.teams[int(tid)].programs) for tid in team_ids]
+    team_offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+    blocks, lengths = [], []
+    prog_action = np.empty(len(program_ids), dtype=np.int64)
+    prog_bank = np.empty(len(program_ids), dtype=np.int64)
+    n_instructions = np.empty(len(program_ids), dtype=np.int64)
+    for i, pid in enumerate(program_ids):
+        prog = pop.programs[int(pid)]
+        code = prog.instructions
+        n_instructions[i] = len(code)
+        if remove_introns:
+            code = code[effective_mask(code, layout)]
+        bank = bank_pos[prog.bank]
+        mapped = code.copy()
+        mapped[:, 1:] = workspace_map(layout, bank, mem_base)[code[:, 1:]]
+        blocks.append(mapped)
+        lengths.append(len(mapped))
+        prog_action[i] = prog.action if prog.action < 0 else team_pos[prog.action]
+        prog_bank[i] = bank
+    instrs = np.concatenate(blocks) if blocks else np.zeros((0, 4), np.int32)
+    return CompiledPopulation(
+        layout=layout,
+        team_ids=team_ids,
+        team_offsets=team_offsets,
+        team_members=np.array(members, dtype=np.int64),
+        program_ids=program_ids,
+        prog_offsets=np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64),
+        instrs=np.ascontiguousarray(instrs, dtype=np.int32),
+        prog_action=prog_action,
+        prog_bank=prog_bank,
+        bank_ids=bank_ids,
+        n_instructions=n_instructions,
+    )

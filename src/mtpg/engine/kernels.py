@@ -1,0 +1,256 @@
+"""Compiled decision, episode and batch kernels.
+
+Every kernel takes the compiled graph as the argument group
+``team_offsets, team_members, prog_offsets, instrs, prog_action, prog_bank, R, M, base``
+(see :class:`~mtpg.engine.compile.CompiledPopulation.kernel_args`) and a per-thread
+float64 workspace ``W`` laid out as documented in :mod:`mtpg.engine.compile`.
+
+Memory banks are reset lazily: ``bank_stamp[b]`` records the episode in which bank ``b``
+was last zeroed, and a program zeroes its bank before running when the stamp is stale.
+Since a program touches only its own bank, this equals zeroing every bank at the start of
+each episode. Visited teams are marked the same way with a per-decision stamp.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from mtpg.engine.ops import apply_op
+from mtpg.envs import env_observe, env_reset, env_step
+from mtpg.envs.core import STATE_SIZE
+from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
+
+_CONSTANTS = CONSTANTS.copy()
+
+
+@njit(cache=True, error_model="numpy")
+def new_workspace(size: int, R: int) -> np.ndarray:  # noqa: N803
+    """Allocates a zeroed workspace with the constants in place."""
+    W = np.zeros(size)  # noqa: N806
+    for i in range(N_CONSTANTS):
+        W[R + i] = _CONSTANTS[i]
+    return W
+
+
+@njit(cache=True, error_model="numpy")
+def run_program(W, prog_offsets, instrs, p, R):  # noqa: N803
+    """Runs program ``p`` on the workspace and returns its bid ``r[0]``."""
+    for i in range(R):
+        W[i] = 0.0
+    for i in range(prog_offsets[p], prog_offsets[p + 1]):
+        dst = instrs[i, 1]
+        W[dst] = apply_op(instrs[i, 0], W[dst], W[instrs[i, 2]], W[instrs[i, 3]])
+    return W[0]
+
+
+@njit(cache=True, error_model="numpy")
+def prepare_bank(W, bank_stamp, bank, episode, no_memory, M, base):  # noqa: N803
+    """Zeroes ``bank`` when it was not yet used in ``episode`` (always, without memory)."""
+    if no_memory or bank_stamp[bank] != episode:
+        off = base + bank * M
+        for j in range(M):
+            W[off + j] = 0.0
+        bank_stamp[bank] = episode
+
+
+@njit(cache=True, error_model="numpy")
+def decide(
+    root,
+    W,
+    team_stamp,
+    stamp,
+    bank_stamp,
+    episode,
+    no_memory,
+    counts,
+    team_offsets,
+    team_members,
+    prog_offsets,
+    instrs,
+    prog_action,
+    prog_bank,
+    R,
+    M,
+    base,
+):  # noqa: N803
+    """Makes one decision: traverses the graph from ``root`` to an atomic action.
+
+    Each visited team runs all its programs in order, then follows the highest bid among
+    programs whose pointer is atomic or leads to a team not yet visited in this decision
+    (ties go to the earlier program).
+
+    Args:
+        root: Dense index of the root team.
+        W: Workspace with the observation in place.
+        team_stamp: int64 ``[n_teams]`` visit marks; ``stamp`` must be new per decision.
+        stamp: This decision's mark.
+        bank_stamp: int64 ``[n_banks]`` episode marks of the banks.
+        episode: This episode's mark.
+        no_memory: Zero each bank before every program execution (ablation).
+        counts: int64 ``[2]`` accumulators: teams visited, instructions executed.
+        team_offsets: The compiled graph (see ``CompiledPopulation``).
+        team_members: The compiled graph.
+        prog_offsets: The compiled graph.
+        instrs: The compiled graph.
+        prog_action: The compiled graph.
+        prog_bank: The compiled graph.
+        R: Private registers per program.
+        M: Registers per memory bank.
+        base: Workspace index of memory bank 0.
+
+    Returns:
+        ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
+    """
+    team = root
+    while True:
+        team_stamp[team] = stamp
+        counts[0] += 1
+        best_p = -1
+        best = 0.0
+        for k in range(team_offsets[team], team_offsets[team + 1]):
+            p = team_members[k]
+            prepare_bank(W, bank_stamp, prog_bank[p], episode, no_memory, M, base)
+            bid = run_program(W, prog_offsets, instrs, p, R)
+            counts[1] += prog_offsets[p + 1] - prog_offsets[p]
+            act = prog_action[p]
+            if (act < 0 or team_stamp[act] != stamp) and (best_p < 0 or bid > best):
+                best = bid
+                best_p = p
+        act = prog_action[best_p]
+        if act < 0:
+            return -1 - act, W[base + prog_bank[best_p] * M]
+        team = act
+
+
+@njit(cache=True, error_model="numpy")
+def run_jobs_strided(
+    chunk,
+    n_chunks,
+    job_root,
+    job_ep,
+    ep_task,
+    ep_start,
+    ep_noise,
+    params,
+    no_memory,
+    out_return,
+    out_steps,
+    out_teams,
+    out_instr,
+    team_offsets,
+    team_members,
+    prog_offsets,
+    instrs,
+    prog_action,
+    prog_bank,
+    R,
+    M,
+    base,
+):  # noqa: N803
+    """Runs jobs ``chunk, chunk + n_chunks, ...`` serially with one private workspace.
+
+    Job ``j`` plays episode ``job_ep[j]`` (task ``ep_task``, start state ``ep_start`` and
+    noise ``ep_noise`` rows) with root ``job_root[j]`` and writes its return, steps,
+    teams visited and instructions executed to the ``out_*`` arrays at ``j``.
+    """
+    n_teams = len(team_offsets) - 1
+    n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
+    W = new_workspace(base + n_banks * M, R)  # noqa: N806
+    team_stamp = np.full(n_teams, -1, dtype=np.int64)
+    bank_stamp = np.full(n_banks, -1, dtype=np.int64)
+    state = np.zeros(STATE_SIZE)
+    counts = np.zeros(2, dtype=np.int64)
+    obs = W[R + N_CONSTANTS : R + N_CONSTANTS + 2]
+    stamp = 0
+    for j in range(chunk, len(job_root), n_chunks):
+        e = job_ep[j]
+        task = ep_task[e]
+        env_reset(task, params, ep_start[e], state)
+        env_observe(task, params, state, ep_noise[e, 0], obs)
+        counts[:] = 0
+        total = 0.0
+        t = 0
+        while True:
+            a_d, a_c = decide(
+                job_root[j],
+                W,
+                team_stamp,
+                stamp,
+                bank_stamp,
+                j,
+                no_memory,
+                counts,
+                team_offsets,
+                team_members,
+                prog_offsets,
+                instrs,
+                prog_action,
+                prog_bank,
+                R,
+                M,
+                base,
+            )
+            stamp += 1
+            reward, terminated, truncated = env_step(task, params, state, a_d, a_c)
+            total += reward
+            t += 1
+            if terminated or truncated:
+                break
+            env_observe(task, params, state, ep_noise[e, t], obs)
+        out_return[j] = total
+        out_steps[j] = t
+        out_teams[j] = counts[0]
+        out_instr[j] = counts[1]
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def run_jobs_parallel(
+    n_chunks,
+    job_root,
+    job_ep,
+    ep_task,
+    ep_start,
+    ep_noise,
+    params,
+    no_memory,
+    out_return,
+    out_steps,
+    out_teams,
+    out_instr,
+    team_offsets,
+    team_members,
+    prog_offsets,
+    instrs,
+    prog_action,
+    prog_bank,
+    R,
+    M,
+    base,
+):  # noqa: N803
+    """Runs all jobs, ``n_chunks`` strided chunks spread over the Numba threads."""
+    for c in prange(n_chunks):
+        run_jobs_strided(
+            c,
+            n_chunks,
+            job_root,
+            job_ep,
+            ep_task,
+            ep_start,
+            ep_noise,
+            params,
+            no_memory,
+            out_return,
+            out_steps,
+            out_teams,
+            out_instr,
+            team_offsets,
+            team_members,
+            prog_offsets,
+            instrs,
+            prog_action,
+            prog_bank,
+            R,
+            M,
+            base,
+        )

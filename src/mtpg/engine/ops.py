@@ -1,0 +1,76 @@
+"""The protected operations of Table 2 as one compiled function.
+
+The semantics (and the protection table) are documented in
+:mod:`mtpg.model.instructions`; the reference interpreter implements the same table in
+plain Python with the same floating-point operations.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, LOG_TINY
+
+
+@njit(cache=True, error_model="numpy")
+def apply_op(op: int, d: float, a: float, b: float) -> float:
+    """Computes one instruction's new target value.
+
+    Args:
+        op: Op code (0..15).
+        d: Current value of the target (read by the conditionals).
+        a: First operand.
+        b: Second operand.
+
+    Returns:
+        The new target value, finite and within ``[-BIG, BIG]``.
+    """
+    if op == 0:
+        v = a + b
+    elif op == 1:
+        v = a - b
+    elif op == 2:
+        v = a * b
+    elif op == 3:
+        v = a if abs(b) < DIV_EPS else a / b
+    elif op == 4:
+        x = abs(a)
+        if x == 0.0:
+            v = 0.0
+        else:
+            e = b * math.log(x)
+            if e > LOG_BIG:
+                v = BIG
+            elif e < LOG_TINY:
+                v = 0.0
+            else:
+                v = math.pow(x, b)
+    elif op == 5:
+        v = math.cos(b)
+    elif op == 6:
+        v = 0.0 if b == 0.0 else math.log(abs(b))
+    elif op == 7:
+        v = BIG if b > LOG_BIG else math.exp(b)
+    elif op == 8:
+        v = math.sqrt(abs(b))
+    elif op == 9:
+        v = math.sin(b)
+    elif op == 10:
+        v = math.tanh(b)
+    elif op == 11:
+        v = b * b
+    elif op == 12:
+        v = abs(b)
+    elif op == 13:
+        v = b * b * b
+    elif op == 14:
+        v = -d if a < b else d
+    else:
+        v = -d if a > b else d
+    if v > BIG:
+        return BIG
+    if v < -BIG:
+        return -BIG
+    return v

@@ -1,0 +1,287 @@
+"""The instruction set of the linear register programs (paper Table 2 and Algorithm 1).
+
+An instruction is four integers ``(op, dst, src1, src2)``. Operands index one logical
+register file per program execution, laid out as
+
+==================  ==========================================  =============
+range               registers                                   access
+==================  ==========================================  =============
+``[0, R)``          private bank ``r`` (zeroed every execution)  read / write
+``[R, R+M)``        the program's shared memory bank ``m``      read / write
+``[R+M, R+M+18)``   the constants -0.9 ... -0.1, 0.1 ... 0.9    read only
+``[R+M+18, +2)``    the observation ``s(t)``                    read only
+==================  ==========================================  =============
+
+with ``R = n_registers`` (8) and ``M = n_memory`` (8). The operand rules of Algorithm 1
+follow from the ranges: ``dst`` is in r or m, ``src1`` in r, m or the constants,
+``src2`` anywhere. Binary operations compute ``dst <- src1 o src2``; unary operations read
+the second operand, ``dst <- o(src2)`` (Table 2 writes them ``r_x[i] <- o(r_y[j])``, with
+``r_y[j]`` the second operand of the binary form, which lets a unary operation read the
+observation); conditionals negate ``dst`` when ``src1 < src2`` (or ``>``).
+
+Protected semantics: every register stays finite. With ``BIG = 1e10``:
+
+=========  =====================================================================
+operation  result
+=========  =====================================================================
+``+ - *``  plain IEEE result, then clamped to ``[-BIG, BIG]``
+``/``      ``a / b``, clamped; ``a`` unchanged when ``|b| < 1e-12`` (no division)
+``pow``    ``|a| ** b``; 0 when ``a == 0``; ``BIG`` when ``b * ln|a| > ln BIG``;
+           0 when ``b * ln|a| < -700``
+``cos``    ``cos(b)``
+``ln``     ``ln|b|``; 0 when ``b == 0``
+``exp``    ``exp(b)``, clamped (``exp(b) = BIG`` when ``b > ln BIG``)
+``sqrt``   ``sqrt(|b|)``
+``sin``    ``sin(b)``
+``tanh``   ``tanh(b)``
+``x^2``    ``b * b``, clamped
+``|x|``    ``|b|``
+``x^3``    ``b * b * b``, clamped
+``IF <``   ``dst <- -dst`` when ``a < b``
+``IF >``   ``dst <- -dst`` when ``a > b``
+=========  =====================================================================
+
+Inputs to every operation are finite and within ``[-BIG, BIG]`` (observations are in
+[-1, 1], memory starts at 0), so the table above covers every case: no NaN or infinity
+can arise. The execution engine and the reference interpreter both implement exactly this
+table with the same floating-point operations, so they agree bit for bit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Operation codes, in op-code order.
+OP_NAMES: tuple[str, ...] = (
+    "add",
+    "sub",
+    "mul",
+    "div",
+    "pow",
+    "cos",
+    "ln",
+    "exp",
+    "sqrt",
+    "sin",
+    "tanh",
+    "square",
+    "abs",
+    "cube",
+    "if_lt",
+    "if_gt",
+)
+N_OPS = len(OP_NAMES)
+OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW = range(5)
+OP_COS, OP_LN, OP_EXP, OP_SQRT, OP_SIN, OP_TANH, OP_SQUARE, OP_ABS, OP_CUBE = range(5, 14)
+OP_IF_LT, OP_IF_GT = 14, 15
+#: Op codes whose result depends on the first operand (binary operations).
+BINARY_OPS = frozenset(range(0, 5))
+#: Op codes reading only the second operand.
+UNARY_OPS = frozenset(range(5, 14))
+#: Op codes that read the target and may negate it.
+CONDITIONAL_OPS = frozenset((OP_IF_LT, OP_IF_GT))
+
+#: The read-only constants appended to the private bank (Table 2).
+CONSTANTS = np.array(
+    [
+        -0.9,
+        -0.8,
+        -0.7,
+        -0.6,
+        -0.5,
+        -0.4,
+        -0.3,
+        -0.2,
+        -0.1,
+        0.1,
+        0.2,
+        0.3,
+        0.4,
+        0.5,
+        0.6,
+        0.7,
+        0.8,
+        0.9,
+    ]
+)
+N_CONSTANTS = len(CONSTANTS)
+#: Magnitude bound of every register value.
+BIG = 1e10
+#: ``ln(BIG)``: exponent above which ``exp`` and ``pow`` saturate.
+LOG_BIG = float(np.log(BIG))
+#: Denominators smaller than this in magnitude leave the numerator unchanged.
+DIV_EPS = 1e-12
+#: ``pow`` results whose log is below this are 0.
+LOG_TINY = -700.0
+
+
+@dataclass(frozen=True, slots=True)
+class RegisterLayout:
+    """Sizes of the register file one program execution sees."""
+
+    n_registers: int = 8
+    """Private stateless registers ``r``; ``r[0]`` is the program's bid."""
+    n_memory: int = 8
+    """Registers of a shared stateful memory bank ``m``; ``m[0]`` is the continuous output."""
+    n_obs: int = 2
+    """Observed inputs ``s(t)``."""
+
+    def __post_init__(self) -> None:
+        for name in ("n_registers", "n_memory", "n_obs"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+
+    @property
+    def mem_start(self) -> int:
+        """First logical index of the memory bank."""
+        return self.n_registers
+
+    @property
+    def const_start(self) -> int:
+        """First logical index of the constants."""
+        return self.n_registers + self.n_memory
+
+    @property
+    def obs_start(self) -> int:
+        """First logical index of the observation."""
+        return self.const_start + N_CONSTANTS
+
+    @property
+    def size(self) -> int:
+        """Number of logical registers."""
+        return self.obs_start + self.n_obs
+
+    def name(self, index: int) -> str:
+        """Human-readable name of a logical register, e.g. ``r[3]``, ``m[0]``, ``s[1]``."""
+        if index < self.mem_start:
+            return f"r[{index}]"
+        if index < self.const_start:
+            return f"m[{index - self.mem_start}]"
+        if index < self.obs_start:
+            return f"{CONSTANTS[index - self.const_start]:+.1f}"
+        return f"s[{index - self.obs_start}]"
+
+
+def _random_operand(
+    rng: np.random.Generator, layout: RegisterLayout, kinds: int, n: int
+) -> np.ndarray:
+    """Draws operand indices: a bank uniformly among the first ``kinds``, then an index.
+
+    Banks, in order: r (with the constants), m, s. Choosing the bank first (as the
+    authors' code does) keeps observations at one third of second operands instead of
+    the 2-in-36 a uniform index would give.
+    """
+    kind = rng.integers(0, kinds, size=n)
+    r_pick = rng.integers(0, layout.n_registers + N_CONSTANTS, size=n)
+    r_index = np.where(
+        r_pick < layout.n_registers, r_pick, layout.const_start + r_pick - layout.n_registers
+    )
+    m_index = layout.mem_start + rng.integers(0, layout.n_memory, size=n)
+    s_index = layout.obs_start + rng.integers(0, layout.n_obs, size=n)
+    return np.choose(kind, [r_index, m_index, s_index]).astype(np.int32)
+
+
+def random_instructions(rng: np.random.Generator, layout: RegisterLayout, n: int) -> np.ndarray:
+    """Draws ``n`` random valid instructions.
+
+    The target is in r or m (one half each, then a uniform index), the first operand in
+    r-with-constants or m, the second in r-with-constants, m or s (one third each).
+
+    Args:
+        rng: The generator to draw from.
+        layout: Register sizes.
+        n: Number of instructions.
+
+    Returns:
+        int32 array of shape ``(n, 4)``: ``op, dst, src1, src2``.
+    """
+    out = np.empty((n, 4), dtype=np.int32)
+    out[:, 0] = rng.integers(0, N_OPS, size=n)
+    dst_mem = rng.integers(0, 2, size=n)
+    out[:, 1] = np.where(
+        dst_mem == 1,
+        layout.mem_start + rng.integers(0, layout.n_memory, size=n),
+        rng.integers(0, layout.n_registers, size=n),
+    )
+    out[:, 2] = _random_operand(rng, layout, 2, n)
+    out[:, 3] = _random_operand(rng, layout, 3, n)
+    return out
+
+
+def valid_instructions(instructions: np.ndarray, layout: RegisterLayout) -> str | None:
+    """Checks operand ranges.
+
+    Args:
+        instructions: int array ``(n, 4)``.
+        layout: Register sizes.
+
+    Returns:
+        None when valid, else a description of the first problem.
+    """
+    if instructions.ndim != 2 or instructions.shape[1] != 4 or len(instructions) == 0:
+        return f"instructions must be a non-empty (n, 4) array, got shape {instructions.shape}"
+    op, dst, a, b = (instructions[:, k] for k in range(4))
+    for name, values, hi in (
+        ("op", op, N_OPS),
+        ("dst", dst, layout.const_start),
+        ("src1", a, layout.obs_start),
+        ("src2", b, layout.size),
+    ):
+        if values.min() < 0 or values.max() >= hi:
+            return f"{name} out of range [0, {hi})"
+    return None
+
+
+def effective_mask(instructions: np.ndarray, layout: RegisterLayout) -> np.ndarray:
+    """Marks the instructions that can affect ``r[0]`` or any memory register.
+
+    A backward liveness pass: the live set starts as ``{r[0]}``; every write to memory is
+    effective (memory is stateful and shared); a write to ``r[i]`` is effective only when
+    ``r[i]`` is live. An effective unconditional write kills its target, then its
+    operands become live (a conditional also reads its target).
+
+    Args:
+        instructions: int array ``(n, 4)``.
+        layout: Register sizes.
+
+    Returns:
+        Boolean array of length ``n``; False marks an intron.
+    """
+    n_r = layout.n_registers
+    live = [False] * n_r
+    live[0] = True
+    mask = np.zeros(len(instructions), dtype=bool)
+    for k in range(len(instructions) - 1, -1, -1):
+        op, dst, a, b = (int(x) for x in instructions[k])
+        if dst < n_r:
+            if not live[dst]:
+                continue
+            if op not in CONDITIONAL_OPS:
+                live[dst] = False
+        mask[k] = True
+        reads = (b,) if op in UNARY_OPS else (a, b)
+        for src in reads:
+            if src < n_r:
+                live[src] = True
+        if op in CONDITIONAL_OPS and dst < n_r:
+            live[dst] = True
+    return mask
+
+
+def disassemble(instructions: np.ndarray, layout: RegisterLayout) -> list[str]:
+    """Renders instructions as text lines, e.g. ``m[0] <- m[7] / s[1]``."""
+    symbols = {"add": "+", "sub": "-", "mul": "*", "div": "/", "pow": "^"}
+    lines = []
+    for op, dst, a, b in instructions:
+        name = OP_NAMES[op]
+        d, x, y = layout.name(dst), layout.name(a), layout.name(b)
+        if op in BINARY_OPS:
+            lines.append(f"{d} <- {x} {symbols[name]} {y}")
+        elif op in UNARY_OPS:
+            lines.append(f"{d} <- {name}({y})")
+        else:
+            cmp = "<" if op == OP_IF_LT else ">"
+            lines.append(f"if {x} {cmp} {y}: {d} <- -{d}")
+    return lines

@@ -1,0 +1,86 @@
+"""Reproducible episodes: start states and noise sequences drawn from one seed per episode."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
+from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT, TASK_NAMES
+from mtpg.envs.tasks import MAX_STEPS, P_FORCE, TASK_PARAMS
+
+_SAMPLERS = (
+    cartpole.sample_start,
+    acrobot.sample_start,
+    cartcentering.sample_start,
+    pendulum.sample_start,
+    mountaincar.sample_start,
+    mountaincar.sample_start,
+)
+
+
+def _check_task(task: int) -> int:
+    task = int(task)
+    if not 0 <= task < len(TASK_NAMES):
+        raise ValueError(f"unknown task id {task}; valid ids are 0..{len(TASK_NAMES) - 1}")
+    return task
+
+
+def sample_start(task: int, rng: np.random.Generator) -> np.ndarray:
+    """Draws a start state with Gymnasium's reset distribution (CartCentering: Koza's).
+
+    The draws are those of the Gymnasium environment's ``reset``, so for the five Gymnasium
+    tasks ``sample_start(task, np.random.default_rng(s))`` equals the state of
+    ``gymnasium.make(name).reset(seed=s)``. CartCentering redraws a start already captured.
+
+    Args:
+        task: The task id.
+        rng: The episode's generator (advanced by the draws).
+
+    Returns:
+        A float64 array of ``STATE_SIZE`` slots: the physical state, then the previous force
+        (``+F``) and the step count (0).
+    """
+    task = _check_task(task)
+    phys = np.asarray(_SAMPLERS[task](rng), dtype=np.float64)
+    start = np.zeros(STATE_SIZE, dtype=np.float64)
+    start[: phys.shape[0]] = phys
+    start[PREV_FORCE_SLOT] = TASK_PARAMS[task, P_FORCE]
+    start[STEP_SLOT] = 0.0
+    return start
+
+
+def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Draws the start states and noise sequences of a batch of episodes.
+
+    For episode ``i``: ``rng = np.random.default_rng(seeds[i])``, the start state is
+    ``sample_start(tasks[i], rng)``, then ``MAX_STEPS[tasks[i]] + 1`` noise values are drawn
+    with ``rng.random``. ``noise[i, 0]`` is observed at reset and ``noise[i, t + 1]`` after
+    step ``t``; padding beyond a task's limit is 0.
+
+    Args:
+        tasks: int array [n] of task ids.
+        seeds: int array [n] of episode seeds.
+
+    Returns:
+        (starts float64 [n, STATE_SIZE], noise float64 [n, max(MAX_STEPS[tasks]) + 1]).
+
+    Raises:
+        ValueError: If the arrays differ in length or a task id is unknown.
+    """
+    tasks = np.asarray(tasks).reshape(-1)
+    seeds = np.asarray(seeds).reshape(-1)
+    if tasks.shape != seeds.shape:
+        raise ValueError(f"tasks and seeds differ in length: {tasks.shape} vs {seeds.shape}")
+    n = tasks.shape[0]
+    for task in tasks:
+        _check_task(task)
+    width = int(MAX_STEPS[tasks.astype(np.int64)].max()) + 1 if n else 1
+    starts = np.zeros((n, STATE_SIZE), dtype=np.float64)
+    noise = np.zeros((n, width), dtype=np.float64)
+    for i in range(n):
+        task = _check_task(tasks[i])
+        rng = np.random.default_rng(int(seeds[i]))
+        starts[i] = sample_start(task, rng)
+        k = int(MAX_STEPS[task]) + 1
+        noise[i, :k] = rng.random(k)
+    return starts, noise

@@ -1,0 +1,33 @@
+"""Registers the six tasks with Gymnasium under the ``mtpg/`` namespace.
+
+Only Gymnasium is imported here; the environment class (and numba) loads when an
+environment is made.
+"""
+
+from __future__ import annotations
+
+from mtpg.envs.core import TASK_NAMES
+
+#: Gymnasium ids, in task-id order.
+GYM_IDS: tuple[str, ...] = tuple(f"mtpg/{name}-v0" for name in TASK_NAMES)
+
+ENTRY_POINT = "mtpg.envs.gym_env:MtpgEnv"
+
+
+def register_envs() -> None:
+    """Registers every task id with Gymnasium (idempotent).
+
+    The time limit is enforced by the environment itself (it reports ``truncated``), so
+    no ``TimeLimit`` wrapper is added.
+    """
+    import gymnasium
+
+    for task, env_id in enumerate(GYM_IDS):
+        if env_id in gymnasium.registry:
+            continue
+        gymnasium.register(
+            id=env_id,
+            entry_point=ENTRY_POINT,
+            kwargs={"task": task},
+            disable_env_checker=False,
+        )

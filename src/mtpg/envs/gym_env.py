@@ -1,0 +1,133 @@
+"""A Gymnasium environment over the compiled kernels, one class for all six tasks.
+
+``gymnasium.make("mtpg/<Task>-v0")`` builds ``MtpgEnv(task=<id>)`` (see
+``mtpg.envs.registration``). The environment uses exactly the kernels of the execution
+engine and the episode draws of ``make_episodes``: ``reset(seed=s)`` seeds the generator
+``np.random.default_rng(s)`` (Gymnasium's ``np_random``), draws the start state with
+``sample_start`` and then one noise value per observation.
+
+``info["state"]`` holds the full hidden state in Gymnasium's order. It is for analysis
+only and must never be fed to an agent.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from mtpg.envs.core import N_OBS, STATE_SIZE, TASK_NAMES
+from mtpg.envs.episodes import sample_start
+from mtpg.envs.kernels import env_observe, env_reset, env_step
+from mtpg.envs.tasks import STATE_DIMS, TASK_PARAMS, USES_CONTINUOUS
+
+
+def _parse_action(action: Any) -> tuple[int, float]:
+    """Splits an action ``(a_d, a_c)`` into an int and a float (a_c may be a 1-array)."""
+    a_d, a_c = action
+    a_d = int(np.asarray(a_d).reshape(-1)[0])
+    a_c = float(np.asarray(a_c, dtype=np.float64).reshape(-1)[0])
+    return a_d, a_c
+
+
+class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
+    """One of the six partially-observable tasks with the paper's interface.
+
+    Observation: ``Box(-1, 1, (2,), float64)``. Action: ``Tuple(Discrete(3),
+    Box(-inf, inf, (1,), float64))``; the task reads one of the two and ignores the other.
+    The time limit is built in (``truncated``), so no ``TimeLimit`` wrapper is needed.
+
+    Args:
+        task: The task id (index into ``TASK_NAMES``).
+        render_mode: None or ``"rgb_array"``.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
+
+    def __init__(self, task: int, render_mode: str | None = None):
+        if not 0 <= int(task) < len(TASK_NAMES):
+            raise ValueError(f"unknown task id {task}")
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"unsupported render_mode {render_mode!r}")
+        self._task = int(task)
+        self.render_mode = render_mode
+        self.observation_space = spaces.Box(-1.0, 1.0, (N_OBS,), dtype=np.float64)
+        self.action_space = spaces.Tuple(
+            (spaces.Discrete(3), spaces.Box(-np.inf, np.inf, (1,), dtype=np.float64))
+        )
+        self._params = TASK_PARAMS
+        self._state = np.zeros(STATE_SIZE, dtype=np.float64)
+        self._obs = np.zeros(N_OBS, dtype=np.float64)
+        self._dim = int(STATE_DIMS[self._task])
+        self._last_action = 0.0
+        self._renderer: Any = None
+
+    def _observe(self) -> np.ndarray:
+        noise = float(self.np_random.random())
+        env_observe(self._task, self._params, self._state, noise, self._obs)
+        return self._obs.copy()
+
+    def _info(self) -> dict[str, Any]:
+        return {"state": self._state[: self._dim].copy()}
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Starts an episode.
+
+        Args:
+            seed: The episode seed; the same seed gives the episode of ``make_episodes``.
+            options: Unused.
+
+        Returns:
+            (observation, info) with ``info["state"]`` the hidden start state.
+        """
+        super().reset(seed=seed)
+        start = sample_start(self._task, self.np_random)
+        env_reset(self._task, self._params, start, self._state)
+        self._last_action = 0.0
+        return self._observe(), self._info()
+
+    def step(
+        self, action: tuple[int, np.ndarray]
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Advances the task by one step.
+
+        Args:
+            action: ``(a_d, a_c)``.
+
+        Returns:
+            (observation, reward, terminated, truncated, info).
+        """
+        a_d, a_c = _parse_action(action)
+        reward, terminated, truncated = env_step(
+            self._task, self._params, self._state, a_d, a_c
+        )
+        self._last_action = a_c if USES_CONTINUOUS[self._task] else 0.0
+        return self._observe(), float(reward), bool(terminated), bool(truncated), self._info()
+
+    def render(self) -> np.ndarray | None:
+        """Draws the current state.
+
+        Returns:
+            An ``H x W x 3`` uint8 frame in ``rgb_array`` mode, else None.
+        """
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode")
+            return None
+        if self._renderer is None:
+            from mtpg.envs.render import make_renderer
+
+            self._renderer = make_renderer(self._task)
+        return self._renderer.frame(self._state, self._last_action)
+
+    def close(self) -> None:
+        """Releases the renderer."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+__all__ = ["MtpgEnv"]

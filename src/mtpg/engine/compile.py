@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mtpg.model.graph import Population
+from mtpg.model.graph import Population, Program
 from mtpg.model.instructions import N_CONSTANTS, RegisterLayout, effective_mask
 
 
@@ -112,6 +112,13 @@ def workspace_map(layout: RegisterLayout, bank: int, mem_base: int) -> np.ndarra
     ).astype(np.int32)
 
 
+def effective_code(prog: Program, layout: RegisterLayout) -> np.ndarray:
+    """The program's effective instructions (cached on the program)."""
+    if prog.effective is None:
+        prog.effective = prog.instructions[effective_mask(prog.instructions, layout)]
+    return prog.effective
+
+
 def compile_population(pop: Population, remove_introns: bool = True) -> CompiledPopulation:
     """Flattens a population for the kernels.
 
@@ -123,46 +130,51 @@ def compile_population(pop: Population, remove_introns: bool = True) -> Compiled
         The compiled population.
     """
     layout = pop.layout
-    team_ids = np.array(sorted(pop.teams), dtype=np.int64)
-    program_ids = np.array(sorted(pop.programs), dtype=np.int64)
-    bank_ids = np.array(sorted(pop.banks()), dtype=np.int64)
-    team_pos = {int(t): i for i, t in enumerate(team_ids)}
-    prog_pos = {int(p): i for i, p in enumerate(program_ids)}
-    bank_pos = {int(b): i for i, b in enumerate(bank_ids)}
-    mem_base = layout.n_registers + N_CONSTANTS + layout.n_obs
+    r, m = layout.n_registers, layout.n_memory
+    team_ids = np.fromiter(pop.teams, dtype=np.int64, count=len(pop.teams))
+    team_ids.sort()
+    program_ids = np.fromiter(pop.programs, dtype=np.int64, count=len(pop.programs))
+    program_ids.sort()
+    progs = [pop.programs[int(pid)] for pid in program_ids]
+    bank_of = np.array([p.bank for p in progs], dtype=np.int64)
+    bank_ids, prog_bank = np.unique(bank_of, return_inverse=True)
+    action = np.array([p.action for p in progs], dtype=np.int64)
+    pointer = action >= 0
+    prog_action = action.copy()
+    prog_action[pointer] = np.searchsorted(team_ids, action[pointer])
 
-    members = [prog_pos[pid] for tid in team_ids for pid in pop.teams[int(tid)].programs]
-    sizes = [len(pop.teams[int(tid)].programs) for tid in team_ids]
-    team_offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    teams = [pop.teams[int(tid)].programs for tid in team_ids]
+    sizes = np.array([len(t) for t in teams], dtype=np.int64)
+    flat = np.fromiter((pid for t in teams for pid in t), dtype=np.int64, count=int(sizes.sum()))
+    team_members = np.searchsorted(program_ids, flat)
 
-    blocks, lengths = [], []
-    prog_action = np.empty(len(program_ids), dtype=np.int64)
-    prog_bank = np.empty(len(program_ids), dtype=np.int64)
-    n_instructions = np.empty(len(program_ids), dtype=np.int64)
-    for i, pid in enumerate(program_ids):
-        prog = pop.programs[int(pid)]
-        code = prog.instructions
-        n_instructions[i] = len(code)
-        if remove_introns:
-            code = code[effective_mask(code, layout)]
-        bank = bank_pos[prog.bank]
-        mapped = code.copy()
-        mapped[:, 1:] = workspace_map(layout, bank, mem_base)[code[:, 1:]]
-        blocks.append(mapped)
-        lengths.append(len(mapped))
-        prog_action[i] = prog.action if prog.action < 0 else team_pos[prog.action]
-        prog_bank[i] = bank
-    instrs = np.concatenate(blocks) if blocks else np.zeros((0, 4), np.int32)
+    if remove_introns:
+        blocks = [effective_code(p, layout) for p in progs]
+    else:
+        blocks = [p.instructions for p in progs]
+    lengths = np.array([len(b) for b in blocks], dtype=np.int64)
+    code = np.concatenate(blocks) if blocks else np.zeros((0, 4), np.int32)
+    mem_base = r + N_CONSTANTS + layout.n_obs
+    bank_per_instr = np.repeat(prog_bank, lengths)[:, None]
+    operands = code[:, 1:].astype(np.int64)
+    mapped = np.where(
+        operands < r,
+        operands,
+        np.where(operands < r + m, mem_base + bank_per_instr * m + operands - r, operands - m),
+    )
+    instrs = np.empty_like(code, dtype=np.int32)
+    instrs[:, 0] = code[:, 0]
+    instrs[:, 1:] = mapped
     return CompiledPopulation(
         layout=layout,
         team_ids=team_ids,
-        team_offsets=team_offsets,
-        team_members=np.array(members, dtype=np.int64),
+        team_offsets=np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+        team_members=team_members.astype(np.int64),
         program_ids=program_ids,
         prog_offsets=np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64),
-        instrs=np.ascontiguousarray(instrs, dtype=np.int32),
+        instrs=instrs,
         prog_action=prog_action,
-        prog_bank=prog_bank,
-        bank_ids=bank_ids,
-        n_instructions=n_instructions,
+        prog_bank=prog_bank.astype(np.int64),
+        bank_ids=bank_ids.astype(np.int64),
+        n_instructions=np.array([len(p.instructions) for p in progs], dtype=np.int64),
     )

@@ -36,12 +36,16 @@ class Program:
         action: ``>= 0``: the id of the team it points to; ``< 0``: atomic action
             ``-1 - action``.
         bank: Id of its shared memory bank.
+        effective: Cache of the effective (non-intron) instructions, filled by the
+            compiler. Instructions are never changed in place (variation copies a
+            program before mutating it), so the cache stays valid.
     """
 
     id: int
     instructions: np.ndarray
     action: int
     bank: int
+    effective: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     @property
     def is_atomic(self) -> bool:

@@ -1,0 +1,297 @@
+"""Run configuration: frozen dataclasses with one docstring per field, presets and TOML.
+
+Every default is the paper's value (Table 3, section 4; ``shared/spec/algorithm.md``).
+A configuration is built from a preset, then a TOML file, then ``section.field=value``
+overrides; each step validates and names the offending field on error.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+from mtpg.envs.core import TASK_NAMES
+
+
+class ConfigError(ValueError):
+    """A configuration value or key is invalid; the message names the field."""
+
+
+def _check(cond: bool, name: str, message: str, value: Any) -> None:
+    if not cond:
+        raise ConfigError(f"{name} {message}, got {value!r}")
+
+
+def _probabilities(obj: Any, section: str) -> None:
+    for f in fields(obj):
+        if f.name.startswith("p_"):
+            value = getattr(obj, f.name)
+            _check(0.0 <= value <= 1.0, f"{section}.{f.name}", "must be in [0, 1]", value)
+
+
+def _positive(obj: Any, section: str, names: tuple[str, ...], minimum: int = 1) -> None:
+    for name in names:
+        value = getattr(obj, name)
+        _check(value >= minimum, f"{section}.{name}", f"must be >= {minimum}", value)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ProgramConfig:
+    """Linear register programs and their mutation (Table 3, program population)."""
+
+    n_registers: int = 8
+    """Size of the private stateless bank ``r``."""
+    n_memory: int = 8
+    """Size of a shared stateful memory bank ``m``."""
+    init_max_length: int = 10
+    """``progSize_init``: initial lengths are uniform in 1..this."""
+    max_length: int = 1000
+    """Longest program allowed (the paper's is unbounded; this only guards memory)."""
+    p_delete: float = 0.5
+    """``p_delete``: probability of deleting a random instruction."""
+    p_add: float = 0.4
+    """``p_add``: probability of inserting a random instruction."""
+    p_mutate: float = 1.0
+    """``p_mutate``: probability of changing one field of one instruction."""
+    p_swap: float = 0.2
+    """``p_swap``: probability of swapping two instructions."""
+
+    def __post_init__(self) -> None:
+        _positive(self, "program", ("n_registers", "n_memory", "init_max_length", "max_length"))
+        _check(self.max_length >= self.init_max_length, "program.max_length",
+               "must be >= program.init_max_length", self.max_length)  # fmt: skip
+        _probabilities(self, "program")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class TeamConfig:
+    """Teams, graphs and their variation (Table 3, team population)."""
+
+    root_size: int = 1000
+    """``R_size``: root teams created at initialisation."""
+    init_team_size: int = 10
+    """``tmSize_init``: programs of each initial team (each new, with a new bank)."""
+    n_elite: int = 50
+    """``n_elite``: children created, and elites kept, per task subset and generation."""
+    p_crossover: float = 0.2
+    """``p_x``: probability that a child is a crossover of two parents (else a clone)."""
+    p_delete: float = 0.7
+    """``p_md``: probability of deleting a program (repeated with decaying probability)."""
+    p_add: float = 0.6
+    """``p_ma``: probability of adding a program from the population (repeated, decaying)."""
+    p_new: float = 0.2
+    """``p_mm``: per program, probability of replacing it by a mutated copy."""
+    p_action: float = 0.1
+    """``p_mn``: probability that a mutated program's action pointer changes."""
+    p_memory: float = 0.1
+    """``p_ms``: probability that a mutated program's memory pointer changes."""
+    p_reorder: float = 0.1
+    """Probability of moving one program to another position in the team."""
+    p_atomic: float = 0.95
+    """``p_atomic``: a changed action pointer becomes atomic with this probability."""
+    max_team_size: int = 1000
+    """Largest team allowed (the paper's is unbounded; this only guards memory)."""
+
+    def __post_init__(self) -> None:
+        _positive(self, "team", ("root_size", "n_elite", "max_team_size"))
+        _positive(self, "team", ("init_team_size",), minimum=2)
+        _probabilities(self, "team")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class EvaluationConfig:
+    """Tasks, episodes and the test protocol (section 4.1 step 3, section 5)."""
+
+    tasks: tuple[str, ...] = TASK_NAMES
+    """Active tasks, by name; the power set of these drives selection."""
+    train_episodes: int = 5
+    """Episodes per task on which each new root is evaluated (seeds 0..n-1)."""
+    test_episodes: int = 100
+    """Episodes per task of each test (seeds disjoint from training)."""
+    test_interval: int = 5
+    """Generations between tests of the champions (0: never)."""
+    no_memory: bool = False
+    """Ablation: zero every memory bank before each program execution."""
+
+    def __post_init__(self) -> None:
+        _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task",
+               self.tasks)  # fmt: skip
+        for name in self.tasks:
+            _check(name in TASK_NAMES, "evaluation.tasks",
+                   f"must be among {', '.join(TASK_NAMES)}", name)  # fmt: skip
+        _check(len(set(self.tasks)) == len(self.tasks), "evaluation.tasks",
+               "must not repeat a task", self.tasks)  # fmt: skip
+        _positive(self, "evaluation", ("train_episodes", "test_episodes"))
+        _positive(self, "evaluation", ("test_interval",), minimum=0)
+
+    @property
+    def task_ids(self) -> tuple[int, ...]:
+        """Task ids of the active tasks, in configuration order."""
+        return tuple(TASK_NAMES.index(t) for t in self.tasks)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class RunConfig:
+    """A whole training run."""
+
+    seed: int = 0
+    """Run seed; every random draw derives from it."""
+    generations: int = 1000
+    """Generations to run (a resumed run continues up to this)."""
+    workers: int = 1
+    """Threads evaluating episodes (results do not depend on it)."""
+    checkpoint_interval: int = 10
+    """Generations between checkpoints (one is also written at exit)."""
+    program: ProgramConfig = field(default_factory=ProgramConfig)
+    """Program settings."""
+    team: TeamConfig = field(default_factory=TeamConfig)
+    """Team and graph settings."""
+    evaluation: EvaluationConfig = field(default_factory=EvaluationConfig)
+    """Task and episode settings."""
+
+    def __post_init__(self) -> None:
+        _positive(self, "run", ("seed", "generations"), minimum=0)
+        _positive(self, "run", ("workers", "checkpoint_interval"))
+
+    @property
+    def no_hierarchy(self) -> bool:
+        """True for the no-hierarchy ablation (``p_atomic = 1``)."""
+        return self.team.p_atomic == 1.0
+
+
+#: Named presets: ``paper`` is Table 3 on all six tasks; ``demo`` is small and quick.
+PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
+    "paper": {},
+    "demo": {
+        "generations": 40,
+        "team": {"root_size": 120, "n_elite": 6},
+        "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},
+    },
+}
+
+#: Ablation switches (section 5.2): each changes exactly one setting.
+ABLATIONS: dict[str, tuple[str, Any]] = {
+    "no-crossover": ("team.p_crossover", 0.0),
+    "no-memory": ("evaluation.no_memory", True),
+    "no-hierarchy": ("team.p_atomic", 1.0),
+}
+
+_SECTIONS = {"program": ProgramConfig, "team": TeamConfig, "evaluation": EvaluationConfig}
+
+
+def _coerce(name: str, ftype: Any, value: Any) -> Any:
+    """Checks ``value`` against the field type; ints are accepted for floats."""
+    expected = {"int": int, "float": float, "bool": bool, "tuple[str, ...]": tuple}[str(ftype)]
+    if expected is float and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    if expected is tuple and isinstance(value, list | tuple):
+        if all(isinstance(v, str) for v in value):
+            return tuple(value)
+    elif isinstance(value, expected) and (expected is bool or not isinstance(value, bool)):
+        return value
+    raise ConfigError(f"{name} must be {ftype}, got {type(value).__name__} {value!r}")
+
+
+def _apply(obj: Any, data: dict[str, Any], prefix: str) -> Any:
+    known = {f.name: f for f in fields(obj)}
+    changes: dict[str, Any] = {}
+    for key, value in data.items():
+        name = f"{prefix}{key}"
+        if key not in known:
+            raise ConfigError(f"unknown field {name!r}")
+        if key in _SECTIONS:
+            if not isinstance(value, dict):
+                raise ConfigError(f"{name} must be a table, got {value!r}")
+            changes[key] = _apply(getattr(obj, key), value, f"{key}.")
+        else:
+            changes[key] = _coerce(name, known[key].type, value)
+    return replace(obj, **changes)
+
+
+def merge(config: RunConfig, data: dict[str, Any]) -> RunConfig:
+    """Returns ``config`` updated with a nested dict (as read from TOML), validated."""
+    return _apply(config, data, "")
+
+
+def parse_override(text: str) -> dict[str, Any]:
+    """Turns ``section.field=value`` (value in TOML syntax) into a nested dict."""
+    if "=" not in text:
+        raise ConfigError(f"override {text!r} must look like section.field=value")
+    key, raw = (s.strip() for s in text.split("=", 1))
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw  # a bare word: a string
+    out: dict[str, Any] = {}
+    node = out
+    *parents, leaf = key.split(".")
+    for part in parents:
+        node = node.setdefault(part, {})
+    node[leaf] = value
+    return out
+
+
+def build_config(preset: str = "paper", toml_file: str | Path | None = None,
+                 overrides: list[str] | None = None) -> RunConfig:  # fmt: skip
+    """Resolves a configuration from a preset, a TOML file and overrides, in that order.
+
+    Args:
+        preset: A name in :data:`PRESETS`.
+        toml_file: Optional TOML file with top-level run fields and ``[program]``,
+            ``[team]``, ``[evaluation]`` tables.
+        overrides: ``section.field=value`` strings.
+
+    Returns:
+        The validated configuration.
+
+    Raises:
+        ConfigError: Naming the offending field, file or preset.
+    """
+    if preset not in PRESETS:
+        raise ConfigError(f"unknown preset {preset!r}; choose from {', '.join(PRESETS)}")
+    config = merge(RunConfig(), PRESETS[preset])
+    if toml_file is not None:
+        try:
+            data = tomllib.loads(Path(toml_file).read_text())
+        except tomllib.TOMLDecodeError as exc:
+            raise ConfigError(f"{toml_file}: not valid TOML: {exc}") from exc
+        try:
+            config = merge(config, data)
+        except ConfigError as exc:
+            raise ConfigError(f"{toml_file}: {exc}") from exc
+    for text in overrides or []:
+        config = merge(config, parse_override(text))
+    return config
+
+
+def to_dict(config: RunConfig) -> dict[str, Any]:
+    """The configuration as a nested dict of plain values."""
+    return dataclasses.asdict(config)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+
+
+def to_toml(config: RunConfig) -> str:
+    """Renders the configuration as TOML that :func:`build_config` reads back exactly."""
+    data = to_dict(config)
+    lines = [f"{k} = {_toml_value(v)}" for k, v in data.items() if k not in _SECTIONS]
+    for section in _SECTIONS:
+        lines += ["", f"[{section}]"]
+        lines += [f"{k} = {_toml_value(v)}" for k, v in data[section].items()]
+    return "\n".join(lines) + "\n"
+
+
+def from_dict(data: dict[str, Any]) -> RunConfig:
+    """Rebuilds a configuration from :func:`to_dict` output, validated."""
+    return merge(RunConfig(), data)

@@ -133,9 +133,7 @@ def step(p: np.ndarray, s: np.ndarray, a_c: float) -> tuple[float, bool]:
     k30, k31, k32, k33 = dsdt(
         p, y0 + dt2 * k20, y1 + dt2 * k21, y2 + dt2 * k22, y3 + dt2 * k23, torque
     )
-    k40, k41, k42, k43 = dsdt(
-        p, y0 + dt * k30, y1 + dt * k31, y2 + dt * k32, y3 + dt * k33, torque
-    )
+    k40, k41, k42, k43 = dsdt(p, y0 + dt * k30, y1 + dt * k31, y2 + dt * k32, y3 + dt * k33, torque)
     c = dt / 6.0
     n0 = y0 + c * (k10 + 2 * k20 + 2 * k30 + k40)
     n1 = y1 + c * (k11 + 2 * k21 + 2 * k31 + k41)

@@ -16,9 +16,7 @@ from mtpg.envs._util import bang_bang_force, clip_obs
 from mtpg.envs.core import PREV_FORCE_SLOT
 
 # Parameter columns (columns 0 and 1 are common to all tasks, see ``mtpg.envs.tasks``).
-MAX_STEPS, FORCE, TAU, GRAVITY, MASSCART, MASSPOLE, LENGTH, X_THRESHOLD, THETA_THRESHOLD = (
-    range(9)
-)
+MAX_STEPS, FORCE, TAU, GRAVITY, MASSCART, MASSPOLE, LENGTH, X_THRESHOLD, THETA_THRESHOLD = range(9)
 
 #: Parameter row, in column order.
 PARAMS: tuple[float, ...] = (

@@ -102,9 +102,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
             (observation, reward, terminated, truncated, info).
         """
         a_d, a_c = _parse_action(action)
-        reward, terminated, truncated = env_step(
-            self._task, self._params, self._state, a_d, a_c
-        )
+        reward, terminated, truncated = env_step(self._task, self._params, self._state, a_d, a_c)
         self._last_action = a_c if USES_CONTINUOUS[self._task] else 0.0
         return self._observe(), float(reward), bool(terminated), bool(truncated), self._info()
 

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from mtpg.envs import cartcentering
 from mtpg.envs._util import clip
 from mtpg.envs.core import (
     ACROBOT,
@@ -75,7 +76,7 @@ class CartCenteringRenderer:
 
         self.pygame = pygame
         self.surf = pygame.Surface((self.width, self.height))
-        self.x_bound = float(TASK_PARAMS[CARTCENTERING, 5])
+        self.x_bound = float(TASK_PARAMS[CARTCENTERING, cartcentering.X_BOUND])
 
     def frame(self, state: np.ndarray, last_action: float) -> np.ndarray:
         """Renders one frame.

@@ -61,8 +61,12 @@ class ProgramConfig:
 
     def __post_init__(self) -> None:
         _positive(self, "program", ("n_registers", "n_memory", "init_max_length", "max_length"))
-        _check(self.max_length >= self.init_max_length, "program.max_length",
-               "must be >= program.init_max_length", self.max_length)  # fmt: skip
+        _check(
+            self.max_length >= self.init_max_length,
+            "program.max_length",
+            "must be >= program.init_max_length",
+            self.max_length,
+        )
         _probabilities(self, "program")
 
 
@@ -76,6 +80,11 @@ class TeamConfig:
     """``tmSize_init``: programs of each initial team (each new, with a new bank)."""
     n_elite: int = 50
     """``n_elite``: children created, and elites kept, per task subset and generation."""
+    min_elite_total: int = 0
+    """Lower bound on elites summed over all subsets: when ``n_elite`` times the number
+    of subsets is smaller, every subset keeps (and breeds) ``ceil(min_elite_total /
+    subsets)`` instead. 0 (the paper) turns it off; it lets one preset serve single-task
+    and six-task runs alike."""
     p_crossover: float = 0.2
     """``p_x``: probability that a child is a crossover of two parents (else a clone)."""
     p_delete: float = 0.7
@@ -98,6 +107,7 @@ class TeamConfig:
     def __post_init__(self) -> None:
         _positive(self, "team", ("root_size", "n_elite", "max_team_size"))
         _positive(self, "team", ("init_team_size",), minimum=2)
+        _positive(self, "team", ("min_elite_total",), minimum=0)
         _probabilities(self, "team")
 
 
@@ -117,15 +127,27 @@ class EvaluationConfig:
     """Ablation: zero every memory bank before each program execution."""
 
     def __post_init__(self) -> None:
-        _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task",
-               self.tasks)  # fmt: skip
+        _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
         for name in self.tasks:
-            _check(name in TASK_NAMES, "evaluation.tasks",
-                   f"must be among {', '.join(TASK_NAMES)}", name)  # fmt: skip
-        _check(len(set(self.tasks)) == len(self.tasks), "evaluation.tasks",
-               "must not repeat a task", self.tasks)  # fmt: skip
+            _check(
+                name in TASK_NAMES,
+                "evaluation.tasks",
+                f"must be among {', '.join(TASK_NAMES)}",
+                name,
+            )
+        _check(
+            len(set(self.tasks)) == len(self.tasks),
+            "evaluation.tasks",
+            "must not repeat a task",
+            self.tasks,
+        )
         _positive(self, "evaluation", ("train_episodes", "test_episodes"))
         _positive(self, "evaluation", ("test_interval",), minimum=0)
+
+    @property
+    def n_subsets(self) -> int:
+        """Number of non-empty task subsets."""
+        return 2 ** len(self.tasks) - 1
 
     @property
     def task_ids(self) -> tuple[int, ...]:
@@ -157,6 +179,12 @@ class RunConfig:
         _positive(self, "run", ("workers", "checkpoint_interval"))
 
     @property
+    def elites_per_subset(self) -> int:
+        """Elites kept, and children bred, per task subset each generation."""
+        n = self.evaluation.n_subsets
+        return max(self.team.n_elite, -(-self.team.min_elite_total // n))
+
+    @property
     def no_hierarchy(self) -> bool:
         """True for the no-hierarchy ablation (``p_atomic = 1``)."""
         return self.team.p_atomic == 1.0
@@ -166,8 +194,8 @@ class RunConfig:
 PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
     "paper": {},
     "demo": {
-        "generations": 40,
-        "team": {"root_size": 120, "n_elite": 6},
+        "generations": 100,
+        "team": {"root_size": 300, "n_elite": 4, "min_elite_total": 100},
         "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},
     },
 }
@@ -234,8 +262,9 @@ def parse_override(text: str) -> dict[str, Any]:
     return out
 
 
-def build_config(preset: str = "paper", toml_file: str | Path | None = None,
-                 overrides: list[str] | None = None) -> RunConfig:  # fmt: skip
+def build_config(
+    preset: str = "paper", toml_file: str | Path | None = None, overrides: list[str] | None = None
+) -> RunConfig:
     """Resolves a configuration from a preset, a TOML file and overrides, in that order.
 
     Args:
@@ -268,8 +297,11 @@ def build_config(preset: str = "paper", toml_file: str | Path | None = None,
 
 
 def to_dict(config: RunConfig) -> dict[str, Any]:
-    """The configuration as a nested dict of plain values."""
-    return dataclasses.asdict(config)
+    """The configuration as a nested dict of JSON-native values (tuples become lists)."""
+    return dataclasses.asdict(
+        config,
+        dict_factory=lambda items: {k: list(v) if isinstance(v, tuple) else v for k, v in items},
+    )
 
 
 def _toml_value(value: Any) -> str:

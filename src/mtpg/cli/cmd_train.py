@@ -1,0 +1,106 @@
+"""``mtpg train``: run (or resume) multi-task TPG training into a run directory."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+
+ABLATION_FLAGS = {
+    "no_crossover": "no-crossover",
+    "no_memory": "no-memory",
+    "no_hierarchy": "no-hierarchy",
+}
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Adds the ``train`` command."""
+    p = subparsers.add_parser(
+        "train",
+        help="evolve program graphs on the tasks",
+        description="Evolve multi-task program graphs. Settings come from a preset, then "
+        "--config FILE, then --set and the named options.",
+    )
+    p.add_argument(
+        "--preset", default="demo", help="configuration preset: paper or demo (default: demo)"
+    )
+    p.add_argument("--config", metavar="FILE", help="TOML file of settings")
+    p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
+    p.add_argument("--generations", type=int, help="generations to run")
+    p.add_argument("--seed", type=int, help="run seed")
+    p.add_argument("--workers", type=int, help="threads evaluating episodes")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SECTION.FIELD=VALUE",
+        help="override any setting, e.g. --set team.n_elite=10 (repeatable)",
+    )
+    for dest, name in ABLATION_FLAGS.items():
+        p.add_argument(f"--{name}", dest=dest, action="store_true", help=f"ablation: {name}")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument(
+        "--out", metavar="RUN_DIR", help="new run directory (default: runs/<preset>-seed<seed>)"
+    )
+    where.add_argument("--resume", metavar="RUN_DIR", help="continue the run in RUN_DIR")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.set_defaults(func=run)
+
+
+def overrides(args: argparse.Namespace) -> list[str]:
+    """The ``section.field=value`` overrides the options stand for."""
+    from mtpg.config import ABLATIONS
+
+    out = list(args.set)
+    if args.tasks:
+        names = [t.strip() for t in args.tasks.split(",") if t.strip()]
+        out.append("evaluation.tasks=[" + ", ".join(f'"{t}"' for t in names) + "]")
+    for key in ("generations", "seed", "workers"):
+        if getattr(args, key) is not None:
+            out.append(f"{key}={getattr(args, key)}")
+    for dest, name in ABLATION_FLAGS.items():
+        if getattr(args, dest):
+            key, value = ABLATIONS[name]
+            out.append(f"{key}={str(value).lower()}")
+    return out
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs the command."""
+    from mtpg.cli.progress import Progress
+    from mtpg.config import build_config, merge, parse_override
+    from mtpg.evolve.session import Session, read_run_config
+
+    if args.resume:
+        config = read_run_config(args.resume)
+        for text in overrides(args):
+            config = merge(config, parse_override(text))
+        session = Session(args.resume, config, resume=True)
+    else:
+        config = build_config(args.preset, args.config, overrides(args))
+        out = args.out or f"runs/{args.preset}-seed{config.seed}"
+        session = Session(out, config)
+    cfg = session.config
+    print(
+        f"run directory: {session.run.path}  (generation {session.trainer.state.generation}"
+        f" of {cfg.generations}; tasks: {', '.join(cfg.evaluation.tasks)})",
+        file=sys.stderr,
+    )
+    progress = None if args.quiet else Progress(cfg.generations, cfg.evaluation.tasks)
+    signal.signal(signal.SIGTERM, _terminate)
+    try:
+        session.run_all(progress)
+    except KeyboardInterrupt:
+        if progress:
+            progress.close()
+        print(
+            f"interrupted; checkpoint written; resume with: mtpg train --resume {session.run.path}",
+            file=sys.stderr,
+        )
+        return 130
+    print(f"done: {session.run.path}", file=sys.stderr)
+    return 0

@@ -1,0 +1,1 @@
+"""Evolution: initialisation, variation, multi-task selection and the generational loop."""

@@ -1,0 +1,65 @@
+"""Multi-task selection over the power set of tasks (paper section 4.1 step 4)."""
+
+from __future__ import annotations
+
+from itertools import combinations
+
+import numpy as np
+
+
+def task_subsets(n_tasks: int) -> list[tuple[int, ...]]:
+    """Every non-empty subset of ``range(n_tasks)``, smallest first.
+
+    The order decides which subset keeps a root that is among the best of several:
+    single tasks claim their elites first, the full set last.
+    """
+    return [s for k in range(1, n_tasks + 1) for s in combinations(range(n_tasks), k)]
+
+
+def normalise(scores: np.ndarray) -> np.ndarray:
+    """Min-max normalises each task's mean scores over the roots.
+
+    Args:
+        scores: float64 ``[n_roots, n_tasks]`` mean training scores.
+
+    Returns:
+        float64 ``[n_roots, n_tasks]`` in [0, 1]; a task where all roots tie gives 1.
+    """
+    lo = scores.min(axis=0)
+    span = scores.max(axis=0) - lo
+    out = np.ones_like(scores)
+    varied = span > 0
+    out[:, varied] = (scores[:, varied] - lo[varied]) / span[varied]
+    return out
+
+
+def select(
+    root_ids: np.ndarray, scores: np.ndarray, subsets: list[tuple[int, ...]], n_elite: int
+) -> tuple[list[list[int]], list[int]]:
+    """Chooses the elites of every task subset and its champion.
+
+    A subset's fitness of a root is its minimum normalised score over the subset's tasks.
+    Roots are ranked by fitness, ties to the younger root (higher id). Each subset keeps
+    its ``n_elite`` best roots not already kept by an earlier subset.
+
+    Args:
+        root_ids: int64 ``[n_roots]`` team ids.
+        scores: float64 ``[n_roots, n_tasks]`` mean training scores.
+        subsets: Task subsets, in claiming order.
+        n_elite: Roots kept per subset.
+
+    Returns:
+        The elites of each subset (team ids, best first) and each subset's champion
+        (its best root, whether or not an earlier subset kept it).
+    """
+    norm = normalise(scores)
+    kept = np.zeros(len(root_ids), dtype=bool)
+    elites, champions = [], []
+    for subset in subsets:
+        fitness = norm[:, list(subset)].min(axis=1)
+        order = np.lexsort((-root_ids, -fitness))
+        champions.append(int(root_ids[order[0]]))
+        free = order[~kept[order]][:n_elite]
+        kept[free] = True
+        elites.append([int(root_ids[i]) for i in free])
+    return elites, champions

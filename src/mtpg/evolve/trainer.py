@@ -1,0 +1,201 @@
+"""The generational loop (paper section 4.1): vary, evaluate new roots, select, delete.
+
+The trainer owns the run state and does no I/O; the CLI writes metrics, checkpoints and
+champions from what :meth:`Trainer.run_generation` returns.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from mtpg.config import RunConfig
+from mtpg.engine.batch import Episodes, evaluate_roots
+from mtpg.engine.compile import compile_population
+from mtpg.envs.core import TASK_NAMES
+from mtpg.evolve.selection import select, task_subsets
+from mtpg.evolve.variation import Varier, init_population
+from mtpg.model.graph import Population
+
+#: Training episode ``k`` of every task uses episode seed ``TRAIN_SEED_BASE + k``.
+TRAIN_SEED_BASE = 0
+#: Test episode ``k`` uses seed ``TEST_SEED_BASE + k``: never a training seed.
+TEST_SEED_BASE = 1_000_000
+#: Metrics columns that measure time and so differ between otherwise identical runs.
+TIMING_COLUMNS = ("decisions_per_s", "t_variation", "t_evaluation", "t_selection", "t_total")
+
+
+def metric_columns(tasks: tuple[str, ...]) -> list[str]:
+    """The ``metrics.csv`` header for a run on ``tasks``."""
+    cols = [
+        "generation",
+        "roots",
+        "teams",
+        "programs",
+        "banks",
+        "new_roots",
+        "decisions",
+        "teams_per_decision",
+        "instructions_per_decision",
+        "champion_teams",
+    ]
+    for task in tasks:
+        cols += [f"best_{task}", f"median_{task}"]
+    return cols + list(TIMING_COLUMNS)
+
+
+@dataclass
+class TrainerState:
+    """Everything a run needs to continue exactly as if never interrupted.
+
+    Attributes:
+        config: The run configuration.
+        generation: Generations completed (0 before initialisation).
+        population: Teams, programs and banks.
+        scores: Mean training score per active task of every evaluated root.
+        elites: Elite root ids of each task subset (``task_subsets`` order).
+        champions: Best root id of each task subset.
+        rng: The generator of every random draw of the run.
+    """
+
+    config: RunConfig
+    generation: int
+    population: Population
+    scores: dict[int, np.ndarray]
+    elites: list[list[int]]
+    champions: list[int]
+    rng: np.random.Generator
+
+    @classmethod
+    def new(cls, config: RunConfig) -> TrainerState:
+        """The state of a run that has not started."""
+        rng = np.random.default_rng(np.random.SeedSequence(config.seed))
+        return cls(config, 0, Population(), {}, [], [], rng)
+
+
+class Trainer:
+    """Runs generations of multi-task TPG.
+
+    Args:
+        config: The run configuration.
+        state: A state to continue from (a fresh run when None).
+    """
+
+    def __init__(self, config: RunConfig, state: TrainerState | None = None) -> None:
+        self.config = config
+        self.state = state or TrainerState.new(config)
+        ev = config.evaluation
+        self.task_ids = list(ev.task_ids)
+        self.subsets = task_subsets(len(self.task_ids))
+        seeds = TRAIN_SEED_BASE + np.arange(ev.train_episodes)
+        self.episodes = Episodes.grid(self.task_ids, seeds)
+
+    @property
+    def done(self) -> bool:
+        """True when the configured number of generations has run."""
+        return self.state.generation >= self.config.generations
+
+    def subset_names(self, k: int) -> tuple[str, ...]:
+        """Task names of subset ``k``."""
+        return tuple(TASK_NAMES[self.task_ids[i]] for i in self.subsets[k])
+
+    def run_generation(self) -> dict[str, float]:
+        """Runs one generation and returns its metrics row.
+
+        Generation 1 creates ``root_size`` random roots; every later generation creates,
+        for each task subset, ``n_elite`` children of a parent drawn from that subset's
+        elites and one drawn from all roots. Then every new root is evaluated on the
+        training episodes of each task, every subset chooses its elites, and every other
+        root is deleted, followed by internal teams no longer referenced, programs no
+        team holds and (implicitly) banks no program uses.
+        """
+        st, cfg = self.state, self.config
+        gen = st.generation + 1
+        t0 = time.perf_counter()
+        if gen == 1:
+            st.population = init_population(cfg, st.rng)
+        else:
+            self._vary(gen)
+        t1 = time.perf_counter()
+        new_roots, result = self._evaluate()
+        t2 = time.perf_counter()
+        self._select()
+        t3 = time.perf_counter()
+        st.generation = gen
+        return self._metrics(new_roots, result, (t0, t1, t2, t3))
+
+    def _vary(self, gen: int) -> None:
+        st = self.state
+        varier = Varier(st.population, self.config, st.rng, gen)
+        roots = sorted(st.scores)
+        for elites in st.elites:
+            pool = elites or roots
+            for _ in range(self.config.elites_per_subset):
+                parent1 = pool[int(st.rng.integers(0, len(pool)))]
+                parent2 = roots[int(st.rng.integers(0, len(roots)))]
+                varier.child(parent1, parent2)
+
+    def _evaluate(self):
+        st = self.state
+        new_roots = [r for r in st.population.roots() if r not in st.scores]
+        cp = compile_population(st.population)
+        returns, result = evaluate_roots(
+            cp, new_roots, self.episodes, self.config.workers, self.config.evaluation.no_memory
+        )
+        n_ep = self.config.evaluation.train_episodes
+        means = returns.reshape(len(new_roots), len(self.task_ids), n_ep).mean(axis=2)
+        for root, row in zip(new_roots, means, strict=True):
+            st.scores[root] = row
+        return new_roots, result
+
+    def _select(self) -> None:
+        st = self.state
+        pop = st.population
+        root_ids = np.array(sorted(st.scores), dtype=np.int64)
+        scores = np.array([st.scores[int(r)] for r in root_ids])
+        st.elites, st.champions = select(
+            root_ids, scores, self.subsets, self.config.elites_per_subset
+        )
+        keep = {r for elites in st.elites for r in elites}
+        for rid in root_ids.tolist():
+            if rid not in keep:
+                del pop.teams[rid]
+                del st.scores[rid]
+        while True:  # internal teams whose last referrer died: never agents, deleted
+            orphans = [t for t, d in pop.in_degree().items() if d == 0 and t not in keep]
+            if not orphans:
+                break
+            for t in orphans:
+                del pop.teams[t]
+        pop.prune()
+
+    def _metrics(self, new_roots, result, times) -> dict[str, float]:
+        st, pop = self.state, self.state.population
+        decisions = int(result.steps.sum())
+        scores = np.array([st.scores[r] for r in sorted(st.scores)])
+        row: dict[str, float] = {
+            "generation": st.generation,
+            "roots": len(st.scores),
+            "teams": len(pop.teams),
+            "programs": len(pop.programs),
+            "banks": len(pop.banks()),
+            "new_roots": len(new_roots),
+            "decisions": decisions,
+            "teams_per_decision": result.teams.sum() / max(decisions, 1),
+            "instructions_per_decision": result.instructions.sum() / max(decisions, 1),
+            "champion_teams": len(pop.reachable(st.champions[-1])),
+        }
+        for k, task in enumerate(self.task_ids):
+            row[f"best_{TASK_NAMES[task]}"] = float(scores[:, k].max())
+            row[f"median_{TASK_NAMES[task]}"] = float(np.median(scores[:, k]))
+        t0, t1, t2, t3 = times
+        row.update(
+            decisions_per_s=decisions / max(t2 - t1, 1e-9),
+            t_variation=t1 - t0,
+            t_evaluation=t2 - t1,
+            t_selection=t3 - t2,
+            t_total=t3 - t0,
+        )
+        return row

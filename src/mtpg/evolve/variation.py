@@ -1,0 +1,176 @@
+"""Initialisation and variation of teams and programs (paper section 4.1, Table 3).
+
+Every function takes the generator it draws from. Programs are never changed in place:
+a mutated program is a new program (new id), so every team that held the original keeps
+its behaviour.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mtpg.config import ProgramConfig, RunConfig, TeamConfig
+from mtpg.model.graph import N_ACTIONS, Population, atomic
+from mtpg.model.instructions import RegisterLayout, random_instructions
+
+
+def init_population(config: RunConfig, rng: np.random.Generator) -> Population:
+    """Creates ``root_size`` root teams of ``init_team_size`` new atomic programs each.
+
+    Every program gets its own new memory bank, a random atomic action and a length
+    uniform in 1..``init_max_length``.
+    """
+    layout = RegisterLayout(config.program.n_registers, config.program.n_memory)
+    pop = Population(layout=layout)
+    for _ in range(config.team.root_size):
+        pids = []
+        for _ in range(config.team.init_team_size):
+            length = int(rng.integers(1, config.program.init_max_length + 1))
+            code = random_instructions(rng, layout, length)
+            action = atomic(int(rng.integers(0, N_ACTIONS)))
+            pids.append(pop.add_program(code, action, pop.new_bank()).id)
+        pop.add_team(pids, birth=0)
+    return pop
+
+
+def mutate_code(
+    code: np.ndarray, cfg: ProgramConfig, layout: RegisterLayout, rng: np.random.Generator
+) -> np.ndarray:
+    """Returns a mutated copy of a program's instructions.
+
+    Four independent trials: delete a random instruction (``p_delete``, kept >= 1 long),
+    insert a random instruction (``p_add``, up to ``max_length``), change one field of one
+    instruction to a different valid value (``p_mutate``), swap two instructions
+    (``p_swap``).
+    """
+    code = code.copy()
+    if rng.random() < cfg.p_delete and len(code) > 1:
+        code = np.delete(code, int(rng.integers(0, len(code))), axis=0)
+    if rng.random() < cfg.p_add and len(code) < cfg.max_length:
+        at = int(rng.integers(0, len(code) + 1))
+        code = np.insert(code, at, random_instructions(rng, layout, 1)[0], axis=0)
+    if rng.random() < cfg.p_mutate:
+        k = int(rng.integers(0, len(code)))
+        column = int(rng.integers(0, 4))
+        for _ in range(16):  # redraw until the field changes (always possible for op)
+            fresh = random_instructions(rng, layout, 1)[0]
+            if fresh[column] != code[k, column]:
+                code[k, column] = fresh[column]
+                break
+    if rng.random() < cfg.p_swap and len(code) > 1:
+        i, j = rng.choice(len(code), size=2, replace=False)
+        code[[i, j]] = code[[j, i]]
+    return code
+
+
+class Varier:
+    """Creates the children of one generation.
+
+    Args:
+        pop: The population (changed in place: new programs and teams are added).
+        config: The run configuration.
+        rng: The variation generator.
+        generation: The generation being created; children and clones are born in it.
+    """
+
+    def __init__(
+        self, pop: Population, config: RunConfig, rng: np.random.Generator, generation: int
+    ) -> None:
+        self.pop = pop
+        self.cfg: TeamConfig = config.team
+        self.pcfg: ProgramConfig = config.program
+        self.rng = rng
+        self.generation = generation
+        self.roots = set(pop.roots())
+        self.targets = [tid for tid, t in pop.teams.items() if t.birth < generation]
+        self.program_pool = list(pop.programs)
+        self.banks = sorted(pop.banks())
+
+    def child(self, parent1: int, parent2: int) -> int:
+        """Creates one new root team from two parents and returns its id."""
+        rng, cfg = self.rng, self.cfg
+        first = self.pop.teams[parent1].programs
+        if rng.random() < cfg.p_crossover:
+            progs = self._crossover(first, self.pop.teams[parent2].programs)
+        else:
+            progs = list(first)
+        self._delete_programs(progs)
+        self._add_programs(progs)
+        if rng.random() < cfg.p_reorder and len(progs) > 1:
+            progs.insert(
+                int(rng.integers(0, len(progs))), progs.pop(int(rng.integers(0, len(progs))))
+            )
+        changed = progs != list(first)
+        for k in range(len(progs)):
+            if rng.random() < cfg.p_new:
+                progs[k] = self._mutated_copy(progs, k)
+                changed = True
+        if not changed:  # a child always differs from its parent
+            k = int(rng.integers(0, len(progs)))
+            progs[k] = self._mutated_copy(progs, k)
+        return self.pop.add_team(progs, birth=self.generation).id
+
+    def _is_atomic(self, pid: int) -> bool:
+        return self.pop.programs[pid].action < 0
+
+    def _crossover(self, a: list[int], b: list[int]) -> list[int]:
+        """Interleaves both parents' programs in order, keeping each with probability 0.5."""
+        child: list[int] = []
+        for i in range(max(len(a), len(b))):
+            for parent in (a, b):
+                if i < len(parent) and self.rng.random() < 0.5 and parent[i] not in child:
+                    child.append(parent[i])
+        if not any(self._is_atomic(p) for p in child):
+            child.append(next(p for p in a if self._is_atomic(p)))
+        for p in a:
+            if len(child) >= 2:
+                break
+            if p not in child:
+                child.append(p)
+        return child
+
+    def _delete_programs(self, progs: list[int]) -> None:
+        """Deletes programs in trials of decaying probability ``p_md, p_md^2, ...``."""
+        p = self.cfg.p_delete
+        while len(progs) > 2 and self.rng.random() < p:
+            n_atomic = sum(self._is_atomic(q) for q in progs)
+            deletable = [k for k, q in enumerate(progs) if n_atomic > 1 or not self._is_atomic(q)]
+            progs.pop(deletable[int(self.rng.integers(0, len(deletable)))])
+            p *= self.cfg.p_delete
+
+    def _add_programs(self, progs: list[int]) -> None:
+        """Adds programs drawn from the whole population, in trials of decaying probability."""
+        p = self.cfg.p_add
+        while len(progs) < self.cfg.max_team_size and self.rng.random() < p:
+            pid = self.program_pool[int(self.rng.integers(0, len(self.program_pool)))]
+            if pid not in progs:
+                progs.insert(int(self.rng.integers(0, len(progs) + 1)), pid)
+            p *= self.cfg.p_add
+
+    def _mutated_copy(self, progs: list[int], k: int) -> int:
+        """Replaces ``progs[k]`` by a mutated copy; returns the copy's id."""
+        rng, old = self.rng, self.pop.programs[progs[k]]
+        code = mutate_code(old.instructions, self.pcfg, self.pop.layout, rng)
+        action, bank = old.action, old.bank
+        if rng.random() < self.cfg.p_action:
+            last_atomic = action < 0 and sum(self._is_atomic(q) for q in progs) == 1
+            action = self._new_action(action, force_atomic=last_atomic)
+        if rng.random() < self.cfg.p_memory and len(self.banks) > 1:
+            choice = self.banks[int(rng.integers(0, len(self.banks) - 1))]
+            bank = choice if choice != old.bank else self.banks[-1]
+        return self.pop.add_program(code, action, bank).id
+
+    def _new_action(self, current: int, force_atomic: bool) -> int:
+        """Draws a new action pointer: atomic with ``p_atomic``, else an older team.
+
+        A root chosen as target is cloned first and the clone is pointed to ("clone when
+        subsumed"), so the root stays an independent agent.
+        """
+        rng = self.rng
+        if force_atomic or not self.targets or rng.random() < self.cfg.p_atomic:
+            return atomic(int(rng.integers(0, N_ACTIONS)))
+        target = self.targets[int(rng.integers(0, len(self.targets)))]
+        if target in self.roots:
+            clone = self.pop.add_team(list(self.pop.teams[target].programs), self.generation)
+            target = clone.id
+        return target

@@ -9,6 +9,16 @@ from mtpg.io.checkpoint import (
     prune_checkpoints,
     save_checkpoint,
 )
+from mtpg.io.rundir import (
+    MetricsWriter,
+    RunDir,
+    RunDirError,
+    champion_filename,
+    init_run_dir,
+    is_run_dir,
+    read_champions,
+    write_champions,
+)
 from mtpg.io.serialize import (
     FormatError,
     graph_from_dict,
@@ -22,9 +32,15 @@ from mtpg.io.serialize import (
 __all__ = [
     "CheckpointError",
     "FormatError",
+    "MetricsWriter",
+    "RunDir",
+    "RunDirError",
+    "champion_filename",
     "checkpoint_path",
     "graph_from_dict",
     "graph_to_dict",
+    "init_run_dir",
+    "is_run_dir",
     "latest_checkpoint",
     "list_checkpoints",
     "load_checkpoint",
@@ -32,6 +48,8 @@ __all__ = [
     "population_from_dict",
     "population_to_dict",
     "prune_checkpoints",
+    "read_champions",
     "save_checkpoint",
     "save_graph",
+    "write_champions",
 ]

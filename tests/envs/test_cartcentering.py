@@ -72,9 +72,10 @@ def test_out_of_bounds_reward() -> None:
 
 
 def test_time_limit_reward() -> None:
-    s = fresh(0.5, 0.0)
-    for _ in range(499):
-        assert step(s, 0 if s[0] < 0 else 2)[0] == 0.0 or False
+    s = fresh(-0.5, 0.0)
+    for t in range(499):  # alternating +F/-F: the cart stays near x = -0.5
+        reward, terminated, truncated = step(s, 2 * (t % 2))
+        assert reward == 0.0 and not terminated and not truncated
     # 500th step: truncated, the terminal penalty includes 0.1 * 500 / 500.
     s2 = fresh(-0.5, 0.0)
     s2[5] = 499.0

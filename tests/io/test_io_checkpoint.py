@@ -62,7 +62,7 @@ def test_round_trip_is_exact(tmp_path):
     [
         ({"a": np.zeros(3)}, "payload['a'] is a ndarray"),
         ({"a": [1, np.int64(2)]}, "payload['a'][1] is a int64"),
-        ({"a": (1, 2)}, "payload['a'] is a tuple"),
+        ({"a": (1, np.float32(2))}, "payload['a'][1] is a float32"),
         ({"a": {1: 2}}, "non-string key 1"),
         ({"a": float("nan")}, "not JSON compliant"),
         ([1, 2], "payload must be a dict"),
@@ -73,6 +73,14 @@ def test_save_refuses_non_native_payload(tmp_path, bad, needle):
         save_checkpoint(tmp_path / "c.json.gz", bad)
     assert "c.json.gz" in str(info.value) and needle in str(info.value)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_tuples_load_back_as_lists(tmp_path):
+    save_checkpoint(tmp_path / "c.json.gz", {"tasks": ("CartPole", "Acrobot"), "p": (1, (2,))})
+    assert load_checkpoint(tmp_path / "c.json.gz") == {
+        "tasks": ["CartPole", "Acrobot"],
+        "p": [1, [2]],
+    }
 
 
 def write(path, data):
@@ -190,6 +198,9 @@ def test_atomic_write_leaves_no_temp_files(tmp_path):
     save_checkpoint(path, SMALL)
     save_checkpoint(path, {**SMALL, "generation": 4})
     assert [p.name for p in path.parent.iterdir()] == ["gen-000005.json.gz"]
+    umask = os.umask(0)
+    os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask  # not mkstemp's private 0o600
 
 
 def test_failed_write_keeps_previous_checkpoint(tmp_path, monkeypatch):

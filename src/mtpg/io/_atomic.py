@@ -11,6 +11,16 @@ from pathlib import Path
 TEMP_SUFFIX = ".tmp"
 
 
+def _read_umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+#: The process umask, read once at import (reading it means briefly changing it).
+_UMASK = _read_umask()
+
+
 def fsync_dir(directory: Path) -> None:
     """Flushes a directory entry to disk (a no-op where directories cannot be opened)."""
     try:
@@ -30,7 +40,8 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
 
     The bytes go to a temporary file in the same directory (``.NAME.XXXX.tmp``), which is
     flushed, fsynced and renamed over ``path``; the directory is then fsynced. On any
-    failure the temporary file is removed and ``path`` is left as it was.
+    failure the temporary file is removed and ``path`` is left as it was. The file gets
+    the mode of the file it replaces, else the usual ``0o666`` less the umask.
 
     Args:
         path: Destination file; its directory must exist.
@@ -42,7 +53,12 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=TEMP_SUFFIX)
     try:
+        mode = path.stat().st_mode & 0o7777
+    except OSError:
+        mode = 0o666 & ~_UMASK
+    try:
         with os.fdopen(fd, "wb") as fh:
+            os.fchmod(fh.fileno(), mode)
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())

@@ -51,7 +51,7 @@ def _check_native(value: Any, where: str) -> None:
                 if not isinstance(key, str):
                     raise TypeError(f"{at} has a non-string key {key!r}")
                 stack.append((sub, f"{at}[{key!r}]"))
-        elif isinstance(item, list):
+        elif isinstance(item, list | tuple):
             if item and all(type(x) is int for x in item):
                 continue  # fast path: a list of plain ints
             stack.extend((sub, f"{at}[{i}]") for i, sub in enumerate(item))
@@ -67,8 +67,9 @@ def canonical_json(payload: Any) -> bytes:
 
     Args:
         payload: JSON-native data: dicts with string keys, lists, strings, ints, finite
-            floats, bools and None (tuples, numpy values and non-string keys are refused
-            because they would not load back unchanged).
+            floats, bools and None. Tuples are written as lists (and load back as
+            lists); numpy values and non-string keys are refused because they would not
+            load back as the values saved.
 
     Returns:
         UTF-8 bytes.

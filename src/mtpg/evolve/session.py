@@ -16,6 +16,7 @@ from mtpg.config import ConfigError, RunConfig, from_dict, to_dict, to_toml
 from mtpg.evolve.persist import state_from_payload, state_to_payload
 from mtpg.evolve.trainer import Trainer, metric_columns
 from mtpg.io.checkpoint import (
+    CheckpointError,
     checkpoint_path,
     latest_checkpoint,
     load_checkpoint,
@@ -23,6 +24,7 @@ from mtpg.io.checkpoint import (
     save_checkpoint,
 )
 from mtpg.io.rundir import MetricsWriter, RunDir, init_run_dir, write_champions
+from mtpg.io.serialize import FormatError
 
 #: Settings a resumed run may change: they do not alter what the run computes.
 RESUMABLE_CHANGES = ("generations", "workers", "checkpoint_interval")
@@ -60,12 +62,15 @@ class Session:
             config = stored
         elif config is None:
             raise ConfigError("a new run needs a configuration")
-        self.run = init_run_dir(run_dir, to_toml(config), resume=resume)
         state = None
-        ckpt = latest_checkpoint(self.run.path) if resume else None
-        if ckpt is not None:
-            state, _ = state_from_payload(load_checkpoint(ckpt))
+        ckpt = latest_checkpoint(run_dir) if resume else None
+        if ckpt is not None:  # read before anything is written: a bad file changes nothing
+            try:
+                state, _ = state_from_payload(load_checkpoint(ckpt))
+            except FormatError as exc:
+                raise CheckpointError(f"{ckpt}: not a valid run state: {exc}") from exc
             state.config = config
+        self.run = init_run_dir(run_dir, to_toml(config), resume=resume)
         self.trainer = Trainer(config, state)
         self.config = config
         self.metrics = MetricsWriter(self.run.metrics, metric_columns(config.evaluation.tasks))

@@ -114,20 +114,25 @@ class Varier:
         return self.pop.programs[pid].action < 0
 
     def _crossover(self, a: list[int], b: list[int]) -> list[int]:
-        """Interleaves both parents' programs in order, keeping each with probability 0.5."""
-        child: list[int] = []
+        """Interleaves both parents' programs in order, keeping each with probability 0.5.
+
+        When the kept programs lack an atomic one, or number fewer than two, the first
+        atomic program and then the first other programs of ``a`` are kept too; every
+        program keeps its place in the interleaving.
+        """
+        order: list[int] = []
         for i in range(max(len(a), len(b))):
             for parent in (a, b):
-                if i < len(parent) and self.rng.random() < 0.5 and parent[i] not in child:
-                    child.append(parent[i])
-        if not any(self._is_atomic(p) for p in child):
-            child.append(next(p for p in a if self._is_atomic(p)))
+                if i < len(parent) and parent[i] not in order:
+                    order.append(parent[i])
+        kept = {p for p in order if self.rng.random() < 0.5}
+        if not any(self._is_atomic(p) for p in kept):
+            kept.add(next(p for p in a if self._is_atomic(p)))
         for p in a:
-            if len(child) >= 2:
+            if len(kept) >= 2:
                 break
-            if p not in child:
-                child.append(p)
-        return child
+            kept.add(p)
+        return [p for p in order if p in kept]
 
     def _delete_programs(self, progs: list[int]) -> None:
         """Deletes programs in trials of decaying probability ``p_md, p_md^2, ...``."""

@@ -1,0 +1,159 @@
+"""End-to-end runs of ``mtpg train`` on tiny budgets."""
+
+import csv
+import gzip
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mtpg.cli.main import main
+from mtpg.evolve.trainer import TIMING_COLUMNS
+
+TINY = [
+    "--tasks",
+    "CartPole,MountainCar",
+    "--set",
+    "team.root_size=20",
+    "--set",
+    "team.n_elite=3",
+    "--set",
+    "team.init_team_size=3",
+    "--set",
+    "evaluation.train_episodes=2",
+    "--set",
+    "team.min_elite_total=0",
+    "--quiet",
+]
+
+
+def metrics(run_dir):
+    with open(Path(run_dir) / "metrics.csv") as fh:
+        return [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in csv.DictReader(fh)]
+
+
+def snapshot(path):
+    return {p: p.read_bytes() for p in sorted(Path(path).rglob("*")) if p.is_file()}
+
+
+def test_train_writes_run_directory(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["train", *TINY, "--generations", "3", "--out", str(out)]) == 0
+    assert (out / "config.toml").is_file()
+    assert len(metrics(out)) == 3
+    assert (out / "checkpoints" / "gen-000003.json.gz").is_file()
+    names = sorted(p.name for p in (out / "champions").glob("*.json"))
+    assert names == ["CartPole+MountainCar.json", "CartPole.json", "MountainCar.json"]
+    # a champion file loads and runs
+    from mtpg.engine.batch import Episodes, evaluate_roots
+    from mtpg.engine.compile import compile_population
+    from mtpg.io.serialize import load_graph
+
+    pop, root, meta = load_graph(out / "champions" / "CartPole.json")
+    returns, _ = evaluate_roots(compile_population(pop), [root], Episodes.grid([0], [0, 1]))
+    assert returns.mean() == pytest.approx(meta["train_scores"]["CartPole"])
+
+
+@pytest.mark.parametrize(
+    ("override", "message"),
+    [
+        ("team.foo=1", "unknown field 'team.foo'"),
+        ('team.n_elite="many"', "team.n_elite must be int"),
+        ("team.root_size=-5", "team.root_size must be >= 1"),
+        ("program.p_swap=1.5", "program.p_swap must be in [0, 1]"),
+    ],
+)
+def test_bad_config_is_refused_and_writes_nothing(tmp_path, capsys, override, message):
+    out = tmp_path / "run"
+    assert main(["train", *TINY, "--set", override, "--out", str(out)]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_bad_config_file_names_file_and_field(tmp_path, capsys):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text("[team]\nn_elite = 2.5\n")
+    assert main(["train", *TINY, "--config", str(cfg), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "bad.toml" in err and "team.n_elite must be int" in err
+
+
+def test_existing_run_is_not_overwritten(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["train", *TINY, "--generations", "1", "--out", str(out)]) == 0
+    before = snapshot(out)
+    assert main(["train", *TINY, "--generations", "1", "--out", str(out)]) == 2
+    assert "already holds an mtpg run" in capsys.readouterr().err
+    assert snapshot(out) == before
+
+
+@pytest.mark.parametrize("damage", ["truncate", "bitflip", "foreign", "version"])
+def test_corrupt_checkpoint_is_refused_on_resume(tmp_path, capsys, damage):
+    out = tmp_path / "run"
+    assert main(["train", *TINY, "--generations", "2", "--out", str(out)]) == 0
+    ckpt = out / "checkpoints" / "gen-000002.json.gz"
+    data = ckpt.read_bytes()
+    if damage == "truncate":
+        ckpt.write_bytes(data[: len(data) // 2])
+    elif damage == "bitflip":
+        raw = bytearray(gzip.decompress(data))
+        raw[len(raw) // 2] ^= 0x04
+        ckpt.write_bytes(gzip.compress(bytes(raw)))
+    elif damage == "foreign":
+        ckpt.write_bytes(gzip.compress(b'{"hello": "world"}'))
+    else:
+        raw = gzip.decompress(data).replace(b'"version":1', b'"version":99')
+        ckpt.write_bytes(gzip.compress(raw))
+    before = snapshot(out)
+    assert main(["train", "--resume", str(out), "--generations", "4", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "gen-000002.json.gz" in err
+    assert snapshot(out) == before
+
+
+def test_sigkill_mid_run_then_resume_reproduces_the_uninterrupted_run(tmp_path):
+    gens = "30"
+    ref = tmp_path / "ref"
+    assert main(["train", *TINY, "--generations", gens, "--out", str(ref)]) == 0
+    run = tmp_path / "killed"
+    cmd = [
+        sys.executable,
+        "-m",
+        "mtpg",
+        "train",
+        *TINY,
+        "--generations",
+        gens,
+        "--set",
+        "checkpoint_interval=2",
+        "--out",
+        str(run),
+    ]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if list((run / "checkpoints").glob("gen-00000[4-9].json.gz")):
+            break
+        time.sleep(0.02)
+    killed = proc.poll() is None
+    if killed:
+        os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert killed, "the run finished before it could be killed"
+    done_before = len(metrics(run))
+    assert done_before < int(gens)
+    env = dict(os.environ)
+    res = subprocess.run(
+        [sys.executable, "-m", "mtpg", "train", "--resume", str(run), "--quiet"],
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+    assert res.returncode == 0, res.stderr
+    assert metrics(run) == metrics(ref)
+    for f in (ref / "champions").glob("*.json"):
+        assert (run / "champions" / f.name).read_bytes() == f.read_bytes()

@@ -1,0 +1,117 @@
+"""``mtpg bench``: benchmarks; ``mtpg bench engine`` times the compiled execution engine."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Adds the ``bench`` command and its ``engine`` subcommand.
+
+    Args:
+        subparsers: The top-level sub-parser collection.
+    """
+    bench = subparsers.add_parser("bench", help="benchmarks", description="Benchmarks.")
+    sub = bench.add_subparsers(dest="bench_command", metavar="BENCH")
+    eng = sub.add_parser(
+        "engine",
+        help="decisions per second of the compiled engine on random graphs driving CartPole",
+        description=(
+            "Times the compiled engine on a fixed, seeded workload: random graphs of "
+            "TEAMS x PROGRAMS x INSTRUCTIONS (about 40%% of programs pointing to a later "
+            "team), each driving CartPole for STEPS decisions with automatic resets. "
+            "The Python reference interpreter and, when installed, the pytpg package are "
+            "timed on the first REFERENCE_GRAPHS graphs. Prints a summary, then one JSON "
+            "object as the last line."
+        ),
+    )
+    eng.add_argument("--graphs", type=int, default=3000, help="number of graphs (3000)")
+    eng.add_argument("--teams", type=int, default=3, help="teams per graph (3)")
+    eng.add_argument("--programs", type=int, default=10, help="programs per team (10)")
+    eng.add_argument("--instructions", type=int, default=10, help="instructions per program (10)")
+    eng.add_argument("--steps", type=int, default=300, help="decisions per graph (300)")
+    eng.add_argument("--threads", type=int, default=1, help="Numba threads (1)")
+    eng.add_argument("--repeats", type=int, default=3, help="timed runs, median reported (3)")
+    eng.add_argument("--seed", type=int, default=0, help="workload seed (0)")
+    eng.add_argument(
+        "--reference-graphs",
+        type=int,
+        default=20,
+        help="graphs played by the reference interpreter and pytpg (20)",
+    )
+    eng.add_argument("--no-pytpg", action="store_true", help="do not time pytpg")
+    eng.set_defaults(func=run)
+    bench.set_defaults(func=lambda _args: _help(bench))
+
+
+def _help(parser: argparse.ArgumentParser) -> int:
+    parser.print_help()
+    return 2
+
+
+def _fmt(value: float | None, unit: str = "") -> str:
+    return "n/a" if value is None else f"{value:,.0f}{unit}"
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs ``mtpg bench engine`` and prints the summary and the JSON line.
+
+    Args:
+        args: Parsed options.
+
+    Returns:
+        0.
+    """
+    from mtpg.engine.bench import benchmark
+
+    def log(msg: str) -> None:
+        print(msg, flush=True)
+
+    r = benchmark(
+        graphs=args.graphs,
+        teams=args.teams,
+        programs=args.programs,
+        instructions=args.instructions,
+        steps=args.steps,
+        threads=args.threads,
+        repeats=args.repeats,
+        seed=args.seed,
+        reference_graphs=args.reference_graphs,
+        pytpg=not args.no_pytpg,
+        log=log,
+    )
+    m = r["machine"]
+    speed_ref = r["speedup_vs_reference"]
+    speed_pt = r["speedup_vs_pytpg"]
+    lines = [
+        "",
+        f"mtpg engine benchmark ({m['cpu']}, {m['cores']} cores, numba {m['numba']})",
+        f"  workload      {r['graphs']} graphs x {r['teams']} teams x {r['programs']} programs"
+        f" x {r['instructions']} instructions, {r['pointer_fraction']:.1%} pointers,"
+        f" CartPole {r['steps']} steps each ({r['episodes']} episodes)",
+        f"  compiled      {_fmt(r['decisions_per_s'])} decisions/s on {r['threads']} thread(s)"
+        f" (median of {r['repeats']}: {r['seconds']:.3f} s for {r['decisions']:,} decisions,"
+        " environment included)",
+        f"                {r['teams_per_decision']:.2f} teams and"
+        f" {r['instructions_per_decision']:.1f} instructions per decision"
+        f" ({r['effective_instruction_fraction']:.0%} of instructions left after intron"
+        f" removal), {_fmt(r['instructions_per_s'])} instructions/s",
+        f"  reference     {_fmt(r['reference_decisions_per_s'])} decisions/s"
+        f" (Python interpreter, {r['reference_graphs']} graphs, same episodes and actions)"
+        + (f"; compiled is {speed_ref:,.0f}x faster" if speed_ref else ""),
+        f"  pytpg         {_fmt(r['pytpg_decisions_per_s'])} decisions/s"
+        + (
+            f" (same graph shapes and observations, own instruction set, no memory,"
+            f" {r['pytpg_teams_per_decision']:.2f} teams per decision);"
+            f" compiled is {speed_pt:,.0f}x faster"
+            if speed_pt
+            else " (not installed or not run)"
+        ),
+        f"  setup         {r['build_seconds']:.1f} s to draw and compile the graphs",
+    ]
+    print("\n".join(lines))
+    sys.stdout.flush()
+    print(json.dumps(r))
+    return 0

@@ -65,6 +65,17 @@ def overrides(args: argparse.Namespace) -> list[str]:
     return out
 
 
+def _fresh_dir(base: str) -> str:
+    """``base``, or ``base-2``, ``base-3``, ... when taken (the default run directory)."""
+    from pathlib import Path
+
+    path, k = base, 1
+    while Path(path).exists():
+        k += 1
+        path = f"{base}-{k}"
+    return path
+
+
 def _terminate(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
@@ -82,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         session = Session(args.resume, config, resume=True)
     else:
         config = build_config(args.preset, args.config, overrides(args))
-        out = args.out or f"runs/{args.preset}-seed{config.seed}"
+        out = args.out or _fresh_dir(f"runs/{args.preset}-seed{config.seed}")
         session = Session(out, config)
     cfg = session.config
     print(

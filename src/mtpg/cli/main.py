@@ -16,6 +16,7 @@ COMMAND_MODULES = (
     "mtpg.cli.cmd_envs",
     "mtpg.cli.cmd_bench",
     "mtpg.cli.cmd_train",
+    "mtpg.cli.cmd_evaluate",
 )
 
 

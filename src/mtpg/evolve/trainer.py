@@ -21,8 +21,6 @@ from mtpg.model.graph import Population
 
 #: Training episode ``k`` of every task uses episode seed ``TRAIN_SEED_BASE + k``.
 TRAIN_SEED_BASE = 0
-#: Test episode ``k`` uses seed ``TEST_SEED_BASE + k``: never a training seed.
-TEST_SEED_BASE = 1_000_000
 #: Metrics columns that measure time and so differ between otherwise identical runs.
 TIMING_COLUMNS = ("decisions_per_s", "t_variation", "t_evaluation", "t_selection", "t_total")
 

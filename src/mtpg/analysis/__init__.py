@@ -1,0 +1,1 @@
+"""Analyses of trained program graphs: test scores, hierarchy, memory, decomposition."""

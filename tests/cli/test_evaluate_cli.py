@@ -1,0 +1,46 @@
+import json
+
+from mtpg.analysis.evaluate import holdout_seeds
+from mtpg.cli.main import main
+from mtpg.evolve.trainer import TRAIN_SEED_BASE
+
+TINY = [
+    "--tasks",
+    "CartPole,CartCentering",
+    "--set",
+    "team.root_size=12",
+    "--set",
+    "team.n_elite=2",
+    "--set",
+    "team.init_team_size=3",
+    "--set",
+    "evaluation.train_episodes=2",
+    "--set",
+    "team.min_elite_total=0",
+    "--quiet",
+]
+
+
+def test_evaluate_run_and_graph_json(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["train", *TINY, "--generations", "2", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["evaluate", str(out), "--episodes", "5", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert set(data) == {"CartPole", "CartCentering"}
+    for row in data.values():
+        assert {"mean", "std", "episodes", "normalised"} <= set(row)
+        assert row["episodes"] == 5
+    graph = out / "champions" / "CartPole.json"
+    assert main(["evaluate", str(graph), "--episodes", "3", "--tasks", "MountainCar"]) == 0
+    assert "MountainCar" in capsys.readouterr().out
+
+
+def test_holdout_seeds_are_disjoint_from_training():
+    seeds = holdout_seeds(100, seed=7)
+    assert len(set(seeds)) == 100 and seeds.min() > TRAIN_SEED_BASE + 1000
+
+
+def test_evaluate_missing_file_is_a_clear_error(tmp_path, capsys):
+    assert main(["evaluate", str(tmp_path / "nope.json")]) == 2
+    assert "nope.json" in capsys.readouterr().err

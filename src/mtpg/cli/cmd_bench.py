@@ -20,7 +20,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="decisions per second of the compiled engine on random graphs driving CartPole",
         description=(
             "Times the compiled engine on a fixed, seeded workload: random graphs of "
-            "TEAMS x PROGRAMS x INSTRUCTIONS (about 40%% of programs pointing to a later "
+            "TEAMS x PROGRAMS x INSTRUCTIONS (about 40% of programs pointing to a later "
             "team), each driving CartPole for STEPS decisions with automatic resets. "
             "The Python reference interpreter and, when installed, the pytpg package are "
             "timed on the first REFERENCE_GRAPHS graphs. Prints a summary, then one JSON "

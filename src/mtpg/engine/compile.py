@@ -37,7 +37,8 @@ class CompiledPopulation:
         program_ids: int64 ``[n_programs]``: model program id of each dense index.
         prog_offsets: int64 ``[n_programs + 1]``: effective instructions of program ``p``
             are ``instrs[prog_offsets[p]:prog_offsets[p + 1]]``.
-        instrs: int32 ``[n, 4]``: ``op, dst, src1, src2`` as workspace indices.
+        instrs: uint32 ``[n, 4]``: ``op, dst, src1, src2`` as workspace indices (unsigned:
+            no negative-index fix-up in the kernels).
         prog_action: int64 ``[n_programs]``: dense team index, or ``-1 - a`` for atomic
             action ``a``.
         prog_bank: int64 ``[n_programs]``: dense memory bank index.
@@ -162,7 +163,7 @@ def compile_population(pop: Population, remove_introns: bool = True) -> Compiled
         operands,
         np.where(operands < r + m, mem_base + bank_per_instr * m + operands - r, operands - m),
     )
-    instrs = np.empty_like(code, dtype=np.int32)
+    instrs = np.empty_like(code, dtype=np.uint32)
     instrs[:, 0] = code[:, 0]
     instrs[:, 1:] = mapped
     return CompiledPopulation(

@@ -194,7 +194,7 @@ class RunConfig:
 PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
     "paper": {},
     "demo": {
-        "generations": 100,
+        "generations": 250,
         "workers": 2,
         "team": {"root_size": 300, "n_elite": 4, "min_elite_total": 100},
         "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},

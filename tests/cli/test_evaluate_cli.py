@@ -1,8 +1,8 @@
 import json
 
-from mtpg.analysis.evaluate import holdout_seeds
 from mtpg.cli.main import main
 from mtpg.evolve.trainer import TRAIN_SEED_BASE
+from mtpg.evolve.trainer import test_seeds as make_test_seeds
 
 TINY = [
     "--tasks",
@@ -37,8 +37,11 @@ def test_evaluate_run_and_graph_json(tmp_path, capsys):
 
 
 def test_holdout_seeds_are_disjoint_from_training():
-    seeds = holdout_seeds(100, seed=7)
-    assert len(set(seeds)) == 100 and seeds.min() > TRAIN_SEED_BASE + 1000
+    from mtpg.config import build_config
+
+    seeds = make_test_seeds(100, offset=7)
+    most_training = build_config("paper").evaluation.train_episodes * 1000
+    assert len(set(seeds)) == 100 and seeds.min() > TRAIN_SEED_BASE + most_training
 
 
 def test_evaluate_missing_file_is_a_clear_error(tmp_path, capsys):

@@ -31,8 +31,8 @@ TINY = [
 ]
 
 
-def metrics(run_dir):
-    with open(Path(run_dir) / "metrics.csv") as fh:
+def metrics(run_dir, name="metrics.csv"):
+    with open(Path(run_dir) / name) as fh:
         return [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in csv.DictReader(fh)]
 
 
@@ -155,5 +155,27 @@ def test_sigkill_mid_run_then_resume_reproduces_the_uninterrupted_run(tmp_path):
     )
     assert res.returncode == 0, res.stderr
     assert metrics(run) == metrics(ref)
+    assert metrics(run, "tests.csv") == metrics(ref, "tests.csv")
     for f in (ref / "champions").glob("*.json"):
         assert (run / "champions" / f.name).read_bytes() == f.read_bytes()
+
+
+def test_test_points_follow_the_interval(tmp_path):
+    out = tmp_path / "run"
+    args = ["--set", "evaluation.test_interval=2", "--set", "evaluation.test_episodes=4"]
+    assert main(["train", *TINY, *args, "--generations", "5", "--out", str(out)]) == 0
+    rows = metrics(out, "tests.csv")
+    assert sorted({int(r["generation"]) for r in rows}) == [2, 4]
+    assert {r["subset"] for r in rows} == {"CartPole", "MountainCar", "CartPole+MountainCar"}
+    for gen in ("gen-000002", "gen-000004"):
+        names = sorted(p.name for p in (out / "tests" / gen).glob("*.json"))
+        assert names == ["CartPole+MountainCar.json", "CartPole.json", "MountainCar.json"]
+    # the stored test score is the champion's mean over the held-out episodes
+    from mtpg.analysis.evaluate import evaluate_graph
+    from mtpg.io.serialize import load_graph
+
+    pop, root, meta = load_graph(out / "tests" / "gen-000004" / "CartPole.json")
+    score = evaluate_graph(pop, root, ["CartPole"], episodes=4)["CartPole"].mean
+    assert score == meta["test"]["CartPole"]
+    row = next(r for r in rows if r["generation"] == "4" and r["subset"] == "CartPole")
+    assert float(row["test_CartPole"]) == score

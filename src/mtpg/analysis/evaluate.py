@@ -9,22 +9,9 @@ import numpy as np
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.reference import REFERENCE, TEST_SEED_BASE, normalise
-from mtpg.evolve.trainer import TRAIN_SEED_BASE
+from mtpg.envs.reference import REFERENCE, normalise
+from mtpg.evolve.trainer import test_seeds
 from mtpg.model.graph import Population
-
-
-def holdout_seeds(episodes: int, seed: int = 0) -> np.ndarray:
-    """Seeds of ``episodes`` test episodes: ``TEST_SEED_BASE + seed + k``.
-
-    With ``seed = 0`` these are the project's test episodes (1_000_000 ...); any
-    ``seed >= 0`` keeps them disjoint from the training seeds (0 ... n_train - 1).
-    """
-    if seed < 0:
-        raise ValueError(f"seed must be >= 0, got {seed}")
-    seeds = TEST_SEED_BASE + seed + np.arange(episodes, dtype=np.int64)
-    assert seeds.min() > TRAIN_SEED_BASE + 100_000
-    return seeds
 
 
 @dataclass(frozen=True)
@@ -78,7 +65,7 @@ def evaluate_graph(
         root: The root team id.
         tasks: Task names.
         episodes: Episodes per task.
-        seed: Offset of the test seeds (see :func:`holdout_seeds`).
+        seed: Offset of the test seeds (see :func:`mtpg.evolve.trainer.test_seeds`).
         workers: Threads.
         no_memory: Evaluate with the no-memory ablation semantics.
 
@@ -86,7 +73,7 @@ def evaluate_graph(
         Scores by task name, in the order given.
     """
     ids = [TASK_NAMES.index(t) for t in tasks]
-    table = Episodes.grid(ids, holdout_seeds(episodes, seed))
+    table = Episodes.grid(ids, test_seeds(episodes, seed))
     returns, result = evaluate_roots(compile_population(pop), [root], table, workers, no_memory)
     returns = returns.reshape(len(ids), episodes)
     steps = result.steps.reshape(len(ids), episodes)

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from mtpg.config import ConfigError, RunConfig, from_dict, to_dict, to_toml
 from mtpg.evolve.persist import state_from_payload, state_to_payload
-from mtpg.evolve.trainer import Trainer, metric_columns
+from mtpg.evolve.trainer import Trainer, metric_columns, test_columns
 from mtpg.io.checkpoint import (
     CheckpointError,
     checkpoint_path,
@@ -23,9 +23,19 @@ from mtpg.io.checkpoint import (
     prune_checkpoints,
     save_checkpoint,
 )
-from mtpg.io.rundir import MetricsWriter, RunDir, init_run_dir, write_champions
-from mtpg.io.serialize import FormatError
+from mtpg.io.rundir import (
+    MetricsWriter,
+    RunDir,
+    champion_filename,
+    init_run_dir,
+    write_champions,
+)
+from mtpg.io.serialize import FormatError, save_graph
 
+#: Test results of the champions, one row per task subset and test point.
+TESTS_FILE = "tests.csv"
+#: Graph files of the tested champions (full task set and single tasks) per test point.
+TESTS_DIR = "tests"
 #: Settings a resumed run may change: they do not alter what the run computes.
 RESUMABLE_CHANGES = ("generations", "workers", "checkpoint_interval")
 
@@ -75,6 +85,10 @@ class Session:
         self.config = config
         self.metrics = MetricsWriter(self.run.metrics, metric_columns(config.evaluation.tasks))
         self.metrics.truncate_after(self.trainer.state.generation)
+        self.tests = MetricsWriter(
+            self.run.path / TESTS_FILE, test_columns(config.evaluation.tasks)
+        )
+        self.tests.truncate_after(self.trainer.state.generation)
         self.saved_generation = self.trainer.state.generation
 
     def run_all(self, on_generation: Callback | None = None) -> None:
@@ -83,6 +97,8 @@ class Session:
             while not self.trainer.done:
                 row = self.trainer.run_generation()
                 self.metrics.append(row)
+                if self.trainer.test_due():
+                    self.test()
                 if on_generation is not None:
                     on_generation(row, self.trainer)
                 if self.trainer.state.generation % self.config.checkpoint_interval == 0:
@@ -91,6 +107,34 @@ class Session:
             if self.trainer.state.generation != self.saved_generation:
                 self.checkpoint()
             self.metrics.close()
+            self.tests.close()
+
+    def test(self) -> list[dict[str, float | int | str]]:
+        """Tests every subset's champion and keeps the graphs of the full set and each task.
+
+        Rows go to ``tests.csv``; graph files to ``tests/gen-NNNNNN/<subset>.json``.
+        """
+        state = self.trainer.state
+        rows = self.trainer.test_champions()
+        for row in rows:
+            self.tests.append(row)
+        keep = {}
+        n = len(self.config.evaluation.tasks)
+        for k, row in enumerate(rows):
+            names = self.trainer.subset_names(k)
+            if len(names) in (1, n):
+                meta = {
+                    "generation": state.generation,
+                    "seed": self.config.seed,
+                    "test": {t: row[f"test_{t}"] for t in self.config.evaluation.tasks},
+                    "test_episodes": self.config.evaluation.test_episodes,
+                }
+                keep[names] = (state.population, int(row["root"]), meta)
+        folder = self.run.path / TESTS_DIR / f"gen-{state.generation:06d}"
+        for names, (pop, root, meta) in keep.items():
+            folder.mkdir(parents=True, exist_ok=True)
+            save_graph(folder / champion_filename(names), pop, root, meta)
+        return rows
 
     def checkpoint(self) -> Path:
         """Writes the champions and an atomic checkpoint of the current generation."""

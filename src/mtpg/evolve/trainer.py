@@ -15,6 +15,7 @@ from mtpg.config import RunConfig
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.reference import TEST_SEED_BASE
 from mtpg.evolve.selection import select, task_subsets
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
@@ -23,6 +24,20 @@ from mtpg.model.graph import Population
 TRAIN_SEED_BASE = 0
 #: Metrics columns that measure time and so differ between otherwise identical runs.
 TIMING_COLUMNS = ("decisions_per_s", "t_variation", "t_evaluation", "t_selection", "t_total")
+
+
+def test_seeds(episodes: int, offset: int = 0) -> np.ndarray:
+    """Seeds of held-out test episodes: ``TEST_SEED_BASE + offset + k``, never training seeds."""
+    if offset < 0:
+        raise ValueError(f"test seed offset must be >= 0, got {offset}")
+    return TEST_SEED_BASE + offset + np.arange(episodes, dtype=np.int64)
+
+
+def test_columns(tasks: tuple[str, ...]) -> list[str]:
+    """The ``tests.csv`` header for a run on ``tasks``."""
+    return ["generation", "subset", "root", "graph_teams", "teams_per_decision"] + [
+        f"test_{t}" for t in tasks
+    ]
 
 
 def metric_columns(tasks: tuple[str, ...]) -> list[str]:
@@ -123,6 +138,45 @@ class Trainer:
         t3 = time.perf_counter()
         st.generation = gen
         return self._metrics(new_roots, result, (t0, t1, t2, t3))
+
+    def test_due(self) -> bool:
+        """True when the generation just completed is a test point."""
+        interval = self.config.evaluation.test_interval
+        return interval > 0 and self.state.generation % interval == 0
+
+    def test_champions(self) -> list[dict[str, float | int | str]]:
+        """Tests the champion of every task subset on held-out episodes of every task.
+
+        Each distinct champion plays ``test_episodes`` episodes of each active task (seeds
+        from :func:`test_seeds`); nothing random is drawn, so testing leaves the run
+        unchanged.
+
+        Returns:
+            One row per subset (``test_columns`` keys), in subset order.
+        """
+        st, ev = self.state, self.config.evaluation
+        roots = sorted(set(st.champions))
+        table = Episodes.grid(self.task_ids, test_seeds(ev.test_episodes))
+        cp = compile_population(st.population)
+        returns, result = evaluate_roots(cp, roots, table, self.config.workers, ev.no_memory)
+        n = len(self.task_ids)
+        means = returns.reshape(len(roots), n, ev.test_episodes).mean(axis=2)
+        per_root = result.teams.reshape(len(roots), -1).sum(axis=1)
+        steps = result.steps.reshape(len(roots), -1).sum(axis=1)
+        rows = []
+        for k, root in enumerate(st.champions):
+            i = roots.index(root)
+            row: dict[str, float | int | str] = {
+                "generation": st.generation,
+                "subset": "+".join(self.subset_names(k)),
+                "root": root,
+                "graph_teams": len(st.population.reachable(root)),
+                "teams_per_decision": float(per_root[i] / steps[i]),
+            }
+            for j, task in enumerate(self.task_ids):
+                row[f"test_{TASK_NAMES[task]}"] = float(means[i, j])
+            rows.append(row)
+        return rows
 
     def _vary(self, gen: int) -> None:
         st = self.state

@@ -17,6 +17,7 @@ COMMAND_MODULES = (
     "mtpg.cli.cmd_bench",
     "mtpg.cli.cmd_train",
     "mtpg.cli.cmd_evaluate",
+    "mtpg.cli.cmd_report",
 )
 
 

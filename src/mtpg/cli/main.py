@@ -18,6 +18,7 @@ COMMAND_MODULES = (
     "mtpg.cli.cmd_train",
     "mtpg.cli.cmd_evaluate",
     "mtpg.cli.cmd_report",
+    "mtpg.cli.cmd_experiment",
 )
 
 

@@ -1,0 +1,77 @@
+"""``mtpg experiment``: seeds of a preset plus the three ablations, then the report."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Adds the ``experiment`` command."""
+    p = subparsers.add_parser(
+        "experiment",
+        help="several seeds plus the three ablations, then a report",
+        description="Run SEEDS seeds of a preset and ABLATION_SEEDS seeds of each ablation "
+        "(no crossover, no memory, no hierarchy) into one folder, as separate processes, "
+        "then write the report. Rerunning the command resumes unfinished runs.",
+    )
+    p.add_argument("--out", required=True, metavar="DIR", help="experiment folder")
+    p.add_argument("--preset", default="demo", help="configuration preset (default demo)")
+    p.add_argument("--config", metavar="FILE", help="TOML file of settings")
+    p.add_argument("--tasks", help="comma-separated task names")
+    p.add_argument("--generations", type=int, help="generations per run")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SECTION.FIELD=VALUE",
+        help="override a setting (repeatable)",
+    )
+    p.add_argument("--seeds", type=int, default=3, help="seeds of the full algorithm (3)")
+    p.add_argument("--ablation-seeds", type=int, default=1, help="seeds per ablation (1)")
+    p.add_argument("--parallel", type=int, default=1, help="runs at the same time (1)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Runs the command."""
+    import sys
+    from pathlib import Path
+
+    from mtpg.cli.cmd_train import overrides
+    from mtpg.cli.main import UsageError, build_parser
+    from mtpg.config import build_config
+    from mtpg.evolve.experiment import execute, plan
+
+    if args.seeds < 1 or args.ablation_seeds < 0 or args.parallel < 1:
+        raise UsageError("--seeds and --parallel must be >= 1, --ablation-seeds >= 0")
+    train_args = ["--preset", args.preset]
+    if args.config:
+        train_args += ["--config", args.config]
+    if args.tasks:
+        train_args += ["--tasks", args.tasks]
+    for text in args.set:
+        train_args += ["--set", text]
+    train_args_ns = build_parser().parse_args(["train", *train_args])
+    if args.generations is not None:
+        train_args_ns.generations = args.generations
+    config = build_config(args.preset, args.config, overrides(train_args_ns))  # validate early
+    workers = max(1, config.workers // args.parallel)
+    folder = Path(args.out)
+    runs = plan(folder, args.seeds, args.ablation_seeds)
+    failed = execute(
+        runs,
+        train_args,
+        config.generations,
+        args.parallel,
+        workers,
+        log=lambda m: print(m, file=sys.stderr),
+    )
+    if failed:
+        names = ", ".join(r.path.name for r in failed)
+        print(
+            f"failed: {names} (see their .log files in {folder}); rerun to resume", file=sys.stderr
+        )
+        return 1
+    from mtpg.cli.cmd_report import run as report
+
+    return report(argparse.Namespace(runs=[str(r.path) for r in runs], out=str(folder / "report")))

@@ -1,0 +1,124 @@
+"""Experiments: several seeds of a preset plus the three ablations, run as processes.
+
+Each run is an ordinary ``mtpg train`` process with its own run directory inside the
+experiment folder; a run already finished is skipped and an unfinished one resumed, so an
+interrupted experiment continues where it stopped.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from mtpg.config import ABLATIONS
+from mtpg.io.checkpoint import list_checkpoints
+from mtpg.io.rundir import is_run_dir
+
+#: Directory-name prefix of each experiment (the labels of paper section 5.2).
+LABELS = {
+    None: "TPG",
+    "no-crossover": "TPG-NoXover",
+    "no-memory": "TPG-NoMemory",
+    "no-hierarchy": "TPG-NoHierarchy",
+}
+
+
+@dataclass(frozen=True)
+class PlannedRun:
+    """One training run of an experiment.
+
+    Attributes:
+        path: Its run directory.
+        seed: Its seed.
+        ablation: The ablation switch, or None for the full algorithm.
+    """
+
+    path: Path
+    seed: int
+    ablation: str | None
+
+    def state(self, generations: int) -> str:
+        """``"new"``, ``"partial"`` or ``"done"``."""
+        if not is_run_dir(self.path):
+            return "new"
+        done = max((g for g, _ in list_checkpoints(self.path)), default=0)
+        return "done" if done >= generations else "partial"
+
+    def command(self, train_args: list[str], generations: int, workers: int) -> list[str]:
+        """The ``mtpg train`` command line that starts or resumes this run."""
+        base = [sys.executable, "-m", "mtpg", "train", "--quiet", "--workers", str(workers)]
+        if is_run_dir(self.path):
+            return [*base, "--resume", str(self.path), "--generations", str(generations)]
+        extra = [f"--{self.ablation}"] if self.ablation else []
+        return [
+            *base,
+            *train_args,
+            *extra,
+            "--generations",
+            str(generations),
+            "--seed",
+            str(self.seed),
+            "--out",
+            str(self.path),
+        ]
+
+
+def plan(folder: Path, seeds: int, ablation_seeds: int) -> list[PlannedRun]:
+    """The runs of an experiment: ``seeds`` full runs and ``ablation_seeds`` per ablation."""
+    runs = [PlannedRun(folder / f"TPG-seed{k}", k, None) for k in range(seeds)]
+    for switch in ABLATIONS:
+        runs += [
+            PlannedRun(folder / f"{LABELS[switch]}-seed{k}", k, switch)
+            for k in range(ablation_seeds)
+        ]
+    return runs
+
+
+def execute(
+    runs: list[PlannedRun],
+    train_args: list[str],
+    generations: int,
+    parallel: int = 1,
+    workers: int = 1,
+    log=print,
+) -> list[PlannedRun]:
+    """Runs every unfinished run, ``parallel`` processes at a time.
+
+    Returns:
+        The runs that failed (empty when all finished).
+    """
+    todo = [r for r in runs if r.state(generations) != "done"]
+    for r in runs:
+        if r not in todo:
+            log(f"{r.path.name}: done")
+    running: list[tuple[PlannedRun, subprocess.Popen]] = []
+    failed = []
+    while todo or running:
+        while todo and len(running) < parallel:
+            run = todo.pop(0)
+            log(f"{run.path.name}: {run.state(generations)} -> starting")
+            run.path.parent.mkdir(parents=True, exist_ok=True)
+            logfile = open(run.path.parent / f"{run.path.name}.log", "a")  # noqa: SIM115
+            running.append(
+                (
+                    run,
+                    subprocess.Popen(
+                        run.command(train_args, generations, workers),
+                        stdout=logfile,
+                        stderr=subprocess.STDOUT,
+                    ),
+                )
+            )
+        time.sleep(0.2)
+        for item in list(running):
+            run, proc = item
+            if proc.poll() is not None:
+                running.remove(item)
+                ok = proc.returncode == 0
+                log(f"{run.path.name}: {'finished' if ok else f'failed ({proc.returncode})'}")
+                if not ok:
+                    failed.append(run)
+    return failed

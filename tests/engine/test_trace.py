@@ -1,0 +1,62 @@
+import numpy as np
+
+from mtpg.engine.compile import compile_population
+from mtpg.engine.trace import trace_episode, trace_sequence
+from mtpg.envs import make_episodes
+from mtpg.model.graph import Population, atomic
+from mtpg.model.instructions import RegisterLayout
+
+L = RegisterLayout()
+M1, S0 = L.mem_start + 1, L.obs_start
+
+
+def one_team(codes, actions=(0, 1)):
+    pop = Population(layout=L)
+    bank = pop.new_bank()
+    pids = [
+        pop.add_program(np.array(c, dtype=np.int32), atomic(a), bank).id
+        for c, a in zip(codes, actions, strict=True)
+    ]
+    pop.add_team(pids)
+    return pop
+
+
+def test_memory_log_records_the_step_of_the_last_write():
+    # program 0: r0 <- m[1] + s[0] (reads m[1]); m[1] <- |s[0]| (writes it)
+    pop = one_team([[[0, 0, M1, S0], [12, M1, 0, S0]], [[0, 0, S0, S0]]])
+    trace = trace_sequence(compile_population(pop), 0, np.full((4, 2), 0.5))
+    reads = trace.mem_log[trace.mem_log[:, 3] == 0]
+    writes = trace.mem_log[trace.mem_log[:, 3] == 1]
+    assert reads[:, 0].tolist() == [0, 1, 2, 3]
+    assert reads[:, 4].tolist() == [-1, 0, 1, 2]  # value read was written one step earlier
+    assert writes[:, 4].tolist() == [-1, 0, 1, 2]  # and overwrites that value
+    assert (reads[:, 2] == 1).all() and (writes[:, 2] == 1).all()
+    # every decision visited the one team and ran both programs
+    assert trace.teams_per_decision().tolist() == [1, 1, 1, 1]
+    assert np.bincount(trace.prog_log[:, 0]).tolist() == [2, 2, 2, 2]
+    assert np.bincount(trace.instr_log[:, 0]).tolist() == [3, 3, 3, 3]
+
+
+def test_no_memory_mode_resets_last_write():
+    pop = one_team([[[0, 0, M1, S0], [12, M1, 0, S0]], [[0, 0, S0, S0]]])
+    trace = trace_sequence(compile_population(pop), 0, np.full((3, 2), 0.5), no_memory=True)
+    reads = trace.mem_log[trace.mem_log[:, 3] == 0]
+    assert reads[:, 4].tolist() == [-1, -1, -1]
+
+
+def test_traced_episode_matches_batch_kernel():
+    from mtpg.engine.batch import Episodes, evaluate_roots
+    from mtpg.engine.workload import layered_graphs
+
+    pop, roots = layered_graphs(np.random.default_rng(4), 6, teams=3, programs=5, instructions=6)
+    cp = compile_population(pop)
+    for task in range(6):
+        eps = Episodes.grid([task], [3])
+        returns, result = evaluate_roots(cp, roots, eps)
+        starts, noise = make_episodes(np.array([task]), np.array([3]))
+        for i, root in enumerate(roots):
+            trace = trace_episode(cp, root, task, starts[0], noise[0])
+            assert sum(trace.rewards.tolist(), 0.0) == returns[i, 0]  # same summation order
+            assert len(trace.actions) == result.steps[i]
+            assert trace.teams_per_decision().sum() == result.teams[i]
+            assert len(trace.instr_log) == result.instructions[i]

@@ -142,3 +142,14 @@ def test_report_page_opens_in_headless_chromium(runs, tmp_path):
     )
     assert res.returncode == 0, res.stderr
     assert shot.is_file() and shot.stat().st_size > 10_000
+
+
+def test_evaluate_run_reports_both_normalisations(runs, capsys):
+    import json
+
+    assert main(["evaluate", str(runs[0]), "--episodes", "3", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    run = load_run(runs[0])
+    for task, row in data.items():
+        assert row["best_single_task"] == run.best_single(task)
+        assert "normalised_single_task" in row and "normalised" in row

@@ -51,6 +51,7 @@ def resolve_graph(target: Path):
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.evaluate import evaluate_graph
+    from mtpg.analysis.runs import normalise_scores
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
 
@@ -63,17 +64,44 @@ def run(args: argparse.Namespace) -> int:
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
     scores = evaluate_graph(pop, root, tasks, args.episodes, args.seed, args.workers)
-    if args.json:
-        print(json.dumps({t: s.as_dict() for t, s in scores.items()}))
+    single = single_task_bests(Path(args.target), tasks)
+    out = {t: s.as_dict() for t, s in scores.items()}
+    for t, best in single.items():
+        out[t]["best_single_task"] = best
+        out[t]["normalised_single_task"] = normalise_scores({t: scores[t].mean}, {t: best})[t]
+    if args.json:  # strict JSON: an undefined ratio (best = random) is null
+        clean = {
+            t: {k: (None if isinstance(v, float) and v != v else v) for k, v in row.items()}
+            for t, row in out.items()
+        }
+        print(json.dumps(clean, allow_nan=False))
         return 0
     print(
         f"{args.target}: root team {root}, {len(pop.reachable(root))} teams; "
         f"{args.episodes} test episodes per task (seed offset {args.seed})"
     )
-    print(f"{'task':<22} {'mean':>10} {'std':>9} {'normalised':>10} {'teams/dec':>9}")
+    print(
+        "normalised: 0 = random play, 1 = reference best"
+        + ("; vs single: 1 = the run's best single-task champion" if single else "")
+    )
+    header = f"{'task':<22} {'mean':>10} {'std':>9} {'normalised':>10} {'teams/dec':>9}"
+    print(header + (f" {'vs single':>9}" if single else ""))
     for t, s in scores.items():
-        print(
+        line = (
             f"{t:<22} {s.mean:>10.3f} {s.std:>9.3f} {s.normalised:>10.3f} "
             f"{s.teams_per_decision:>9.2f}"
         )
+        if t in single:
+            line += f" {out[t]['normalised_single_task']:>9.3f}"
+        print(line)
     return 0
+
+
+def single_task_bests(target: Path, tasks: list[str]) -> dict[str, float]:
+    """Best test score of each task's single-task champion, for a run directory with tests."""
+    from mtpg.analysis.runs import load_run
+
+    if not (target.is_dir() and (target / "tests.csv").is_file()):
+        return {}
+    run = load_run(target)
+    return {t: run.best_single(t) for t in tasks if t in run.tasks and run.curve(t, t)[0].size}

@@ -7,6 +7,7 @@ timing columns), because the checkpoint holds the whole state including the gene
 
 from __future__ import annotations
 
+import time
 import tomllib
 from collections.abc import Callable
 from dataclasses import replace
@@ -96,9 +97,12 @@ class Session:
         try:
             while not self.trainer.done:
                 row = self.trainer.run_generation()
-                self.metrics.append(row)
                 if self.trainer.test_due():
+                    start = time.perf_counter()
                     self.test()
+                    row["t_test"] = time.perf_counter() - start
+                    row["t_total"] += row["t_test"]
+                self.metrics.append(row)
                 if on_generation is not None:
                     on_generation(row, self.trainer)
                 if self.trainer.state.generation % self.config.checkpoint_interval == 0:

@@ -23,7 +23,14 @@ from mtpg.model.graph import Population
 #: Training episode ``k`` of every task uses episode seed ``TRAIN_SEED_BASE + k``.
 TRAIN_SEED_BASE = 0
 #: Metrics columns that measure time and so differ between otherwise identical runs.
-TIMING_COLUMNS = ("decisions_per_s", "t_variation", "t_evaluation", "t_selection", "t_total")
+TIMING_COLUMNS = (
+    "decisions_per_s",
+    "t_variation",
+    "t_evaluation",
+    "t_selection",
+    "t_test",
+    "t_total",
+)
 
 
 def test_seeds(episodes: int, offset: int = 0) -> np.ndarray:
@@ -248,6 +255,7 @@ class Trainer:
             t_variation=t1 - t0,
             t_evaluation=t2 - t1,
             t_selection=t3 - t2,
+            t_test=0.0,
             t_total=t3 - t0,
         )
         return row

@@ -11,25 +11,10 @@ from mtpg.analysis.runs import load_run, normalise_scores, reference_best, vs_si
 from mtpg.cli.main import main
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
 from mtpg.envs.reference import REFERENCE, measure_random, measure_time_optimal_cartcentering
+from tinyruns import tiny_args
 
 TINY = [
-    "--tasks",
-    "CartPole,CartCentering",
-    "--set",
-    "team.root_size=12",
-    "--set",
-    "team.n_elite=3",
-    "--set",
-    "team.init_team_size=3",
-    "--set",
-    "evaluation.train_episodes=2",
-    "--set",
-    "team.min_elite_total=0",
-    "--set",
-    "evaluation.test_interval=2",
-    "--set",
-    "evaluation.test_episodes=3",
-    "--quiet",
+    *tiny_args(n_elite=3, evaluation__test_interval=2, evaluation__test_episodes=3),
     "--generations",
     "4",
 ]

@@ -3,22 +3,9 @@ import json
 from mtpg.cli.main import main
 from mtpg.evolve.trainer import TRAIN_SEED_BASE
 from mtpg.evolve.trainer import test_seeds as make_test_seeds
+from tinyruns import tiny_args
 
-TINY = [
-    "--tasks",
-    "CartPole,CartCentering",
-    "--set",
-    "team.root_size=12",
-    "--set",
-    "team.n_elite=2",
-    "--set",
-    "team.init_team_size=3",
-    "--set",
-    "evaluation.train_episodes=2",
-    "--set",
-    "team.min_elite_total=0",
-    "--quiet",
-]
+TINY = tiny_args()
 
 
 def test_evaluate_run_and_graph_json(tmp_path, capsys):

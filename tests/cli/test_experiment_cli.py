@@ -1,23 +1,7 @@
 from mtpg.cli.main import main
+from tinyruns import tiny_args
 
-TINY = [
-    "--tasks",
-    "CartPole,CartCentering",
-    "--set",
-    "team.root_size=12",
-    "--set",
-    "team.n_elite=2",
-    "--set",
-    "team.init_team_size=3",
-    "--set",
-    "evaluation.train_episodes=2",
-    "--set",
-    "team.min_elite_total=0",
-    "--set",
-    "evaluation.test_interval=2",
-    "--set",
-    "evaluation.test_episodes=2",
-]
+TINY = tiny_args(quiet=False, evaluation__test_interval=2, evaluation__test_episodes=2)
 
 
 def test_experiment_runs_seeds_and_ablations_then_resumes(tmp_path, capsys):

@@ -13,22 +13,9 @@ import pytest
 
 from mtpg.cli.main import main
 from mtpg.evolve.trainer import TIMING_COLUMNS
+from tinyruns import tiny_args
 
-TINY = [
-    "--tasks",
-    "CartPole,MountainCar",
-    "--set",
-    "team.root_size=20",
-    "--set",
-    "team.n_elite=3",
-    "--set",
-    "team.init_team_size=3",
-    "--set",
-    "evaluation.train_episodes=2",
-    "--set",
-    "team.min_elite_total=0",
-    "--quiet",
-]
+TINY = tiny_args("CartPole,MountainCar", root_size=20, n_elite=3)
 
 
 def metrics(run_dir, name="metrics.csv"):

@@ -66,14 +66,17 @@ def test_default_report_location(runs, capsys):
 )
 def test_every_figure_has_labelled_axes_and_a_legend(runs, tmp_path, monkeypatch, draw):
     figs = []
+    import matplotlib.pyplot as plt
+
     monkeypatch.setattr(plots, "_save", lambda fig, path: figs.append(fig) or path)
+    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig) if fig else None)
     draw([load_run(p) for p in runs], tmp_path / "x.png")
-    (fig,) = figs
+    fig = figs[0]
     used = [ax for ax in fig.axes if ax.axison]
     assert used
     for ax in used:
         assert ax.get_xlabel() and ax.get_ylabel() and ax.get_title()
-        assert ax.get_legend() is not None
+        assert ax.get_legend() is not None or fig.legends
 
 
 def test_normalisation_is_0_for_random_and_1_for_the_reference_controller():

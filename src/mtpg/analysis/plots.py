@@ -77,10 +77,14 @@ def learning_curves(runs: list[RunData], path: Path) -> Path:
         ax.set_title(task)
         ax.set_xlabel("generation")
         ax.set_ylabel("mean test return\n(reward per episode)")
-        ax.legend(fontsize=7, loc="best")
     for ax in list(axes.flat)[len(tasks) :]:
         ax.axis("off")
-    return _save(fig, path)
+    handles, labels = axes.flat[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
 
 
 def _task_axis(ax, tasks: tuple[str, ...]) -> None:

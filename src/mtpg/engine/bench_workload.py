@@ -28,10 +28,9 @@ import numpy as np
 from numba import njit, prange
 
 from mtpg.engine.compile import CompiledPopulation, compile_population
-from mtpg.engine.kernels import decide, new_workspace
+from mtpg.engine.kernels import decide, thread_buffers
 from mtpg.engine.workload import layered_graphs
 from mtpg.envs import CARTPOLE, TASK_PARAMS, env_observe, env_reset, env_step, make_episodes
-from mtpg.envs.core import STATE_SIZE
 from mtpg.model.graph import Population
 from mtpg.model.instructions import N_CONSTANTS
 
@@ -187,13 +186,7 @@ def drive_strided(
     """
     n_graphs = len(roots)
     n_pool = ep_start.shape[0]
-    n_teams = len(team_offsets) - 1
-    n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
-    W = new_workspace(base + n_banks * M, R)  # noqa: N806
-    team_stamp = np.full(n_teams, -1, dtype=np.int64)
-    bank_stamp = np.full(n_banks, -1, dtype=np.int64)
-    state = np.zeros(STATE_SIZE)
-    counts = np.zeros(2, dtype=np.int64)
+    W, team_stamp, bank_stamp, state, counts = thread_buffers(team_offsets, prog_bank, R, M, base)  # noqa: N806
     obs = W[R + N_CONSTANTS : R + N_CONSTANTS + 2]
     stamp = 0
     episode = 0

@@ -34,6 +34,16 @@ def new_workspace(size: int, R: int) -> np.ndarray:  # noqa: N803
 
 
 @njit(cache=True, error_model="numpy")
+def thread_buffers(team_offsets, prog_bank, R, M, base):  # noqa: N803
+    """One thread's private state: workspace, visit and bank stamps, task state, counters."""
+    n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
+    W = new_workspace(base + n_banks * M, R)  # noqa: N806
+    team_stamp = np.full(len(team_offsets) - 1, -1, dtype=np.int64)
+    bank_stamp = np.full(n_banks, -1, dtype=np.int64)
+    return W, team_stamp, bank_stamp, np.zeros(STATE_SIZE), np.zeros(2, dtype=np.int64)
+
+
+@njit(cache=True, error_model="numpy")
 def decide(
     root,
     W,
@@ -154,13 +164,7 @@ def run_jobs_strided(
     noise ``ep_noise`` rows) with root ``job_root[j]`` and writes its return, steps,
     teams visited and instructions executed to the ``out_*`` arrays at ``j``.
     """
-    n_teams = len(team_offsets) - 1
-    n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
-    W = new_workspace(base + n_banks * M, R)  # noqa: N806
-    team_stamp = np.full(n_teams, -1, dtype=np.int64)
-    bank_stamp = np.full(n_banks, -1, dtype=np.int64)
-    state = np.zeros(STATE_SIZE)
-    counts = np.zeros(2, dtype=np.int64)
+    W, team_stamp, bank_stamp, state, counts = thread_buffers(team_offsets, prog_bank, R, M, base)  # noqa: N806
     obs = W[R + N_CONSTANTS : R + N_CONSTANTS + 2]
     stamp = 0
     for j in range(chunk, len(job_root), n_chunks):

@@ -20,12 +20,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.cli.main import UsageError
-
-    try:
-        import matplotlib  # noqa: F401
-    except ModuleNotFoundError as exc:
-        raise UsageError("drawing figures needs matplotlib: pip install 'mtpg[plot]'") from exc
     from mtpg.analysis.report import build_report
 
     index = build_report(args.runs, args.out)

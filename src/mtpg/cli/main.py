@@ -19,6 +19,10 @@ COMMAND_MODULES = (
     "mtpg.cli.cmd_evaluate",
     "mtpg.cli.cmd_report",
     "mtpg.cli.cmd_experiment",
+    "mtpg.cli.cmd_show",
+    "mtpg.cli.cmd_replay",
+    "mtpg.cli.cmd_analyze",
+    "mtpg.cli.cmd_export",
 )
 
 

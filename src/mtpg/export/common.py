@@ -1,0 +1,200 @@
+"""What every exporter needs: the reachable graph, introns removed, and its provenance.
+
+:func:`prepare` turns a population and a root into an :class:`ExportGraph`: only the
+teams reachable from the root (depth-first from it, the root first), the programs they
+hold (in order of first use) with their introns removed exactly as the engine removes
+them (:func:`mtpg.model.instructions.effective_mask`), and the memory banks those
+programs point to, all renumbered densely from 0. The code generators then only print.
+
+The execution semantics the generated code reproduces are those of
+:func:`mtpg.engine.kernels.decide` and :func:`mtpg.engine.ops.apply_op`:
+
+* a decision starts at the root with no team visited; visiting a team marks it, then runs
+  ALL its programs in team order (losers write memory too); each run zeroes the private
+  registers ``r`` and, in no-memory mode, first zeroes the program's bank;
+* the winner is the highest bid ``r[0]`` among programs whose action is atomic or points
+  to a team not yet visited in this decision; ties go to the earlier program;
+* an atomic winner ends the decision with ``(a_d, a_c)`` = its action and ``m[0]`` of its
+  bank as it is after the whole team ran; a pointer winner moves to its team;
+* banks are zeroed at the start of every episode (the engine zeroes lazily, which is the
+  same thing because a program touches only its own bank).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from mtpg.model.graph import Population
+from mtpg.model.instructions import (
+    BIG,
+    CONSTANTS,
+    DIV_EPS,
+    LOG_BIG,
+    LOG_TINY,
+    OP_NAMES,
+    RegisterLayout,
+    effective_mask,
+)
+
+#: Numeric constants of the protected operation table, by the name the generated code uses.
+TABLE_CONSTANTS: dict[str, float] = {
+    "BIG": BIG,
+    "LOG_BIG": LOG_BIG,
+    "LOG_TINY": LOG_TINY,
+    "DIV_EPS": DIV_EPS,
+}
+
+#: Observations every task provides (the API of the generated code is fixed to two).
+N_OBS = 2
+
+
+@dataclass(frozen=True)
+class ExportProgram:
+    """One program of the exported graph.
+
+    Attributes:
+        id: Program id in the source population.
+        code: int ``(n, 4)`` effective instructions (logical operand layout).
+        n_total: Instructions before intron removal.
+        bank: Dense bank index.
+        target: Dense team index it points to, or ``-1 - a`` for atomic action ``a``.
+    """
+
+    id: int
+    code: np.ndarray
+    n_total: int
+    bank: int
+    target: int
+
+    @property
+    def is_atomic(self) -> bool:
+        """True when the program ends a decision."""
+        return self.target < 0
+
+
+@dataclass(frozen=True)
+class ExportGraph:
+    """A program graph reduced to what one root can execute.
+
+    Attributes:
+        layout: Register sizes.
+        team_ids: Source team id of each dense team; index 0 is the root.
+        teams: Dense program indices of each team, in execution order.
+        programs: The programs, in order of first use.
+        bank_ids: Source bank id of each dense bank.
+        no_memory: Zero a program's bank before each of its runs (ablation mode).
+        provenance: Ordered ``(label, value)`` facts printed in the generated header.
+    """
+
+    layout: RegisterLayout
+    team_ids: list[int]
+    teams: list[list[int]]
+    programs: list[ExportProgram]
+    bank_ids: list[int]
+    no_memory: bool
+    provenance: list[tuple[str, str]]
+
+    @property
+    def n_instructions(self) -> int:
+        """Effective instructions over all programs."""
+        return sum(len(p.code) for p in self.programs)
+
+    @property
+    def n_introns(self) -> int:
+        """Instructions removed as introns."""
+        return sum(p.n_total - len(p.code) for p in self.programs)
+
+    def operand(self, index: int) -> tuple[str, int | float]:
+        """Classifies a logical operand: ``("r"|"m"|"s", index)`` or ``("c", value)``."""
+        lay = self.layout
+        if index < lay.mem_start:
+            return "r", int(index)
+        if index < lay.const_start:
+            return "m", int(index - lay.mem_start)
+        if index < lay.obs_start:
+            return "c", float(CONSTANTS[index - lay.const_start])
+        return "s", int(index - lay.obs_start)
+
+    def summary(self) -> str:
+        """One line: teams, programs, banks, instructions and introns removed."""
+        return (
+            f"{len(self.teams)} teams, {len(self.programs)} programs, {len(self.bank_ids)} "
+            f"memory banks, {self.n_instructions} instructions ({self.n_introns} introns "
+            f"removed)"
+        )
+
+
+def prepare(
+    pop: Population,
+    root: int,
+    *,
+    no_memory: bool,
+    source: str = "(in memory)",
+    meta: dict[str, Any] | None = None,
+    memory_description: str | None = None,
+) -> ExportGraph:
+    """Reduces a population to the graph of ``root``, ready for a code generator.
+
+    Args:
+        pop: The population holding the graph.
+        root: Root team id.
+        no_memory: Generate code that zeroes each bank before every program execution.
+        source: Where the graph came from (printed as provenance).
+        meta: The graph file's metadata (generation, seed, tasks, ``no_memory``).
+        memory_description: How the memory setting was chosen (printed as provenance).
+
+    Returns:
+        The reduced graph.
+
+    Raises:
+        ValueError: When ``root`` is not a team of ``pop`` or the layout does not have
+            exactly two observations.
+    """
+    if root not in pop.teams:
+        raise ValueError(f"root team {root} is not in the population")
+    layout = pop.layout
+    if layout.n_obs != N_OBS:
+        raise ValueError(f"layout.n_obs must be {N_OBS} for export, got {layout.n_obs}")
+    team_ids = pop.reachable(root)
+    team_index = {tid: k for k, tid in enumerate(team_ids)}
+    prog_ids = list(dict.fromkeys(pid for tid in team_ids for pid in pop.teams[tid].programs))
+    prog_index = {pid: k for k, pid in enumerate(prog_ids)}
+    bank_ids = list(dict.fromkeys(pop.programs[pid].bank for pid in prog_ids))
+    bank_index = {bid: k for k, bid in enumerate(bank_ids)}
+    programs = []
+    for pid in prog_ids:
+        prog = pop.programs[pid]
+        code = np.asarray(prog.instructions, dtype=np.int64)
+        code = code[effective_mask(prog.instructions, layout)]
+        target = prog.action if prog.is_atomic else team_index[prog.action]
+        programs.append(
+            ExportProgram(pid, code, len(prog.instructions), bank_index[prog.bank], target)
+        )
+    teams = [[prog_index[pid] for pid in pop.teams[tid].programs] for tid in team_ids]
+    meta = dict(meta or {})
+    evolved_off = bool(meta.get("no_memory", False))
+    provenance = [
+        ("source", source),
+        ("root team", str(root)),
+        ("generation", str(meta.get("generation", "unknown"))),
+        ("seed", str(meta.get("seed", "unknown"))),
+        ("evolved", "without memory (TPG-NoMemory)" if evolved_off else "with memory"),
+        (
+            "exported",
+            memory_description
+            or ("memory off: banks zeroed before every program" if no_memory else "memory on"),
+        ),
+    ]
+    if "tasks" in meta:
+        provenance.append(("tasks", ", ".join(str(t) for t in meta["tasks"])))
+    graph = ExportGraph(layout, team_ids, teams, programs, bank_ids, no_memory, provenance)
+    graph.provenance.append(("graph", graph.summary()))
+    return graph
+
+
+def op_name(op: int) -> str:
+    """Name of an op code (as in :data:`mtpg.model.instructions.OP_NAMES`)."""
+    return OP_NAMES[int(op)]

@@ -1,0 +1,180 @@
+"""Python code generation: one module needing nothing but the standard library's ``math``.
+
+The generated module has ``reset()`` (zero all memory banks: episode start) and
+``act(obs) -> (a_d, a_c)`` (one decision; memory persists between calls), plus
+``TEAM_IDS`` and ``last_teams`` (the team ids the last decision visited).
+
+Bit-identity: Python floats are IEEE doubles and the protected operations are written as
+the engine's table (:func:`mtpg.engine.ops.apply_op`) with the functions the engine's
+reference interpreter uses (``math.log``, ``math.pow``, ``math.exp``, ``math.cos``,
+``math.sin``, ``math.tanh``, ``math.sqrt``, ``abs``). Every input to them is finite and
+within the clamp bound, where CPython's ``math`` functions return the C library's result
+(they add only error checks for non-finite or overflowing results, which the protection
+rules out), so the module agrees with the engine bit for bit on the same C library.
+``math.pow`` is used rather than ``**`` because that is what the engine computes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, op_name
+
+#: Expression of each protected operation (``d`` target, ``a``/``b`` operands).
+_OPS: dict[str, tuple[str, str]] = {
+    "add": ("a, b", "return _clamp(a + b)"),
+    "sub": ("a, b", "return _clamp(a - b)"),
+    "mul": ("a, b", "return _clamp(a * b)"),
+    "div": ("a, b", "return _clamp(a if abs(b) < DIV_EPS else a / b)"),
+    "pow": (
+        "a, b",
+        "x = abs(a)\n    if x == 0.0:\n        return 0.0\n    e = b * math.log(x)\n"
+        "    if e > LOG_BIG:\n        return BIG\n    if e < LOG_TINY:\n        return 0.0\n"
+        "    return _clamp(math.pow(x, b))",
+    ),
+    "cos": ("b", "return _clamp(math.cos(b))"),
+    "ln": ("b", "return _clamp(0.0 if b == 0.0 else math.log(abs(b)))"),
+    "exp": ("b", "return _clamp(BIG if b > LOG_BIG else math.exp(b))"),
+    "sqrt": ("b", "return _clamp(math.sqrt(abs(b)))"),
+    "sin": ("b", "return _clamp(math.sin(b))"),
+    "tanh": ("b", "return _clamp(math.tanh(b))"),
+    "square": ("b", "return _clamp(b * b)"),
+    "abs": ("b", "return _clamp(abs(b))"),
+    "cube": ("b", "return _clamp(b * b * b)"),
+    "if_lt": ("d, a, b", "return _clamp(-d if a < b else d)"),
+    "if_gt": ("d, a, b", "return _clamp(-d if a > b else d)"),
+}
+
+
+def _operand(graph: ExportGraph, index: int) -> str:
+    kind, value = graph.operand(int(index))
+    if kind == "c":
+        return repr(float(value))
+    if kind == "r":
+        return f"r{value}"
+    return f"{kind}[{value}]"
+
+
+def _program_function(graph: ExportGraph, k: int, prog: ExportProgram) -> str:
+    body = []
+    registers: set[int] = {0}
+    for op, dst, a, b in prog.code.tolist():
+        name = op_name(op)
+        args = [_operand(graph, b)]
+        if name in ("add", "sub", "mul", "div", "pow"):
+            args.insert(0, _operand(graph, a))
+        elif name in ("if_lt", "if_gt"):
+            args[:0] = [_operand(graph, dst), _operand(graph, a)]
+        for idx in (dst, a, b):
+            kind, value = graph.operand(int(idx))
+            if kind == "r":
+                registers.add(int(value))
+        body.append(f"    {_operand(graph, dst)} = _{name}({', '.join(args)})")
+    text = "\n".join(body)
+    head = [
+        f"def _p{k}(s):",
+        f'    """Program {prog.id}: bank {graph.bank_ids[prog.bank]}, '
+        f'{len(prog.code)} of {prog.n_total} instructions."""',
+    ]
+    if graph.no_memory or "m[" in text:
+        head.append(f"    m = _MEM[{prog.bank}]")
+    if graph.no_memory:
+        head.append("    m[:] = _ZEROS  # memory off: the bank is zeroed before every run")
+    head.append("    " + " = ".join(f"r{i}" for i in sorted(registers)) + " = 0.0")
+    return "\n".join(head + body + ["    return r0"])
+
+
+def _team_function(graph: ExportGraph, t: int) -> str:
+    lines = [
+        f"def _t{t}(s, visited):",
+        f'    """Team {graph.team_ids[t]}: returns (next team or -1 - action, winner bank)."""',
+        "    have, best, nxt, bank = False, 0.0, -1, 0",
+    ]
+    for k in graph.teams[t]:
+        prog = graph.programs[k]
+        lines.append(f"    bid = _p{k}(s)")
+        if prog.is_atomic:
+            lines.append(
+                f"    if not have or bid > best:  # program {prog.id}: action {-1 - prog.target}"
+            )
+            lines.append(f"        have, best, nxt, bank = True, bid, {prog.target}, {prog.bank}")
+        else:
+            lines.append(
+                f"    if not visited[{prog.target}] and (not have or bid > best):"
+                f"  # program {prog.id}: team {graph.team_ids[prog.target]}"
+            )
+            lines.append(f"        have, best, nxt = True, bid, {prog.target}")
+    lines.append("    return nxt, bank")
+    return "\n".join(lines)
+
+
+def module_text(graph: ExportGraph) -> str:
+    """The whole generated module."""
+    width = max(len(label) for label, _ in graph.provenance)
+    prov = "\n".join(f"    {label + ':':<{width + 1}} {value}" for label, value in graph.provenance)
+    used = sorted({op_name(op) for p in graph.programs for op in p.code[:, 0].tolist()})
+    n_mem = graph.layout.n_memory
+    parts = [
+        f'''"""An mtpg program graph as a standalone Python module (generated by mtpg export).
+
+{prov}
+
+Usage: call reset() at the start of every episode (it zeroes all memory banks), then
+act(obs) once per step with the two observations; it returns (a_d, a_c): the discrete
+action (0, 1 or 2) and the continuous output (m[0] of the winning program's memory bank).
+Memory persists between calls. Needs only the standard library; the results equal the
+mtpg engine's bit for bit (IEEE doubles, same C library math functions).
+"""
+
+import math''',
+        "\n".join(f"{key} = {value!r}" for key, value in TABLE_CONSTANTS.items()),
+        f"#: Source id of each team; index 0 is the root.\nTEAM_IDS = "
+        f"{tuple(graph.team_ids)!r}\n#: Memory banks (source ids {list(graph.bank_ids)}).\n"
+        f"_MEM = [[0.0] * {n_mem} for _ in range({len(graph.bank_ids)})]\n"
+        f"_ZEROS = [0.0] * {n_mem}\n#: Team ids visited by the last decision, in order.\n"
+        "last_teams = []",
+        'def reset():\n    """Zeroes every memory bank: call at the start of every episode."""\n'
+        "    for bank in _MEM:\n        bank[:] = _ZEROS",
+        "def _clamp(v):\n    if v > BIG:\n        return BIG\n"
+        "    if v < -BIG:\n        return -BIG\n    return v",
+    ]
+    for op in used:
+        params, body = _OPS[op]
+        parts.append(f"def _{op}({params}):\n    {body}")
+    parts.extend(_program_function(graph, k, p) for k, p in enumerate(graph.programs))
+    parts.extend(_team_function(graph, t) for t in range(len(graph.teams)))
+    parts.append(f"_TEAMS = ({', '.join(f'_t{t}' for t in range(len(graph.teams)))},)")
+    parts.append(
+        "def act(obs):\n"
+        '    """One decision for observation obs (two numbers): returns (a_d, a_c)."""\n'
+        "    s = (float(obs[0]), float(obs[1]))\n"
+        f"    visited = [False] * {len(graph.teams)}\n"
+        "    del last_teams[:]\n"
+        "    team = 0\n"
+        "    while True:\n"
+        "        visited[team] = True\n"
+        "        last_teams.append(TEAM_IDS[team])\n"
+        "        nxt, bank = _TEAMS[team](s, visited)\n"
+        "        if nxt < 0:\n"
+        "            return -1 - nxt, _MEM[bank][0]\n"
+        "        team = nxt"
+    )
+    return "\n\n\n".join(parts) + "\n"
+
+
+def write_python(graph: ExportGraph, path) -> Path:
+    """Writes the module to ``path`` (its directory is created if missing).
+
+    Args:
+        graph: The prepared graph.
+        path: Destination ``.py`` file.
+
+    Returns:
+        The path written.
+    """
+    out = Path(path)
+    if out.suffix != ".py":
+        raise ValueError(f"--out must name a .py file for --lang python, got {out}")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(module_text(graph), encoding="utf-8")
+    return out

@@ -8,7 +8,7 @@ import pytest
 from mtpg.envs.core import TASK_NAMES
 from mtpg.export.c import write_c
 from mtpg.export.common import prepare
-from mtpg.export.harness import build_driver, find_compiler, run_check
+from mtpg.export.harness import build_driver, compile_driver, find_compiler, run_check
 from mtpg.export.python import write_python
 from tinyruns import tiny_args
 
@@ -42,15 +42,33 @@ def evolved(tmp_path_factory):
     return out, cases
 
 
+@pytest.fixture(scope="session")
+def drivers(cc, tmp_path_factory):
+    """The C driver compiled once per session: plain and with ``-DMTPG_TRACE``."""
+    folder = tmp_path_factory.mktemp("drivers")
+    return {
+        trace: compile_driver(folder / f"driver{int(trace)}.o", trace=trace, compiler=cc)
+        for trace in (False, True)
+    }
+
+
 @pytest.fixture
-def c_runner(cc, tmp_path):
-    """Exports a graph to C, builds the driver and returns its decisions on a stream."""
+def c_runner(cc, drivers, tmp_path):
+    """Exports a graph to C, builds it with the driver, returns its decisions on a stream."""
 
     def run(pop, root, stream, no_memory=False, trace=False, opt="-O2"):
         graph = prepare(pop, root, no_memory=no_memory)
         folder = tmp_path / f"c{next(_counter)}"
         write_c(graph, folder, "champ")
-        exe = build_driver(folder, "champ", folder / "driver", trace=trace, opt=opt, compiler=cc)
+        exe = build_driver(
+            folder,
+            "champ",
+            folder / "driver",
+            trace=trace,
+            opt=opt,
+            compiler=cc,
+            driver_object=drivers[trace],
+        )
         return run_check(exe, stream)
 
     return run

@@ -23,11 +23,11 @@ EXTREME = [0.0, 1.0, -1.0, 1e-300, -1e-300, 1e10, -1e10, 1e300, -1e300, 0.5]
 def random_cases():
     """Random graphs: tangled (shared programs and banks, cycles) and layered."""
     cases = []
-    for seed in (11, 12, 13):
+    for seed in (11, 12):
         rng = np.random.default_rng(seed)
         pop = tangled_population(rng, 8, 24, 16, 3, 0.6)
         cases.append((f"tangled-{seed}", pop, int(rng.choice(list(pop.teams)))))
-    pop, roots = layered_graphs(np.random.default_rng(4), 2, teams=4, programs=6, instructions=12)
+    pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=4, programs=6, instructions=12)
     cases += [(f"layered-{r}", pop, r) for r in roots]
     return cases
 

@@ -15,7 +15,12 @@ it visits.
 Bit-identity: every protected operation is written as the engine's table
 (:func:`mtpg.engine.ops.apply_op`), calling the same C library functions (``log``,
 ``pow``, ``exp``, ``cos``, ``sin``, ``tanh``, ``sqrt``) in the same order and clamping in
-the same way, and constants are printed as shortest round-trip decimals. With IEEE double
+the same way, and constants are printed as shortest round-trip decimals. The generated
+code is specialised to one graph, so many arguments are known at compile time (private
+registers start at 0, constants are literals): the functions that are not correctly
+rounded are therefore called through ``volatile`` pointers, which stops compilers from
+evaluating them with their own (correctly rounded) arithmetic, a difference in the last
+bit that the tests did catch. With IEEE double
 arithmetic (SSE2 or any FPU without extended precision) and no floating-point contraction
 (``-ffp-contract=off``; no ``-ffast-math``), results equal the engine's bit for bit as
 long as the C library's ``log``/``pow``/``exp``/``cos``/``sin``/``tanh`` are the ones the
@@ -67,6 +72,10 @@ _OPS: dict[str, tuple[str, str]] = {
     "if_lt": ("double d, double a, double b", "return mtpg_clamp(a < b ? -d : d);"),
     "if_gt": ("double d, double a, double b", "return mtpg_clamp(a > b ? -d : d);"),
 }
+
+
+def _params(function: str) -> str:
+    return "double, double" if function == "pow" else "double"
 
 
 def _literal(value: float) -> str:
@@ -157,8 +166,9 @@ def header_text(graph: ExportGraph, name: str) -> str:
  * Bit-identity: compiled as C99 with IEEE double arithmetic and WITHOUT floating-point
  * contraction (gcc/clang: -ffp-contract=off; never -ffast-math), every a_d and a_c equals
  * the mtpg engine's bit for bit, given the same C library math functions (log, pow, exp,
- * cos, sin, tanh) as the engine ran with. Compile with -DMTPG_TRACE to record the teams
- * each decision visits.
+ * cos, sin, tanh) as the engine ran with; those are called through volatile pointers so
+ * that the compiler cannot evaluate them at compile time with its own rounding. Compile
+ * with -DMTPG_TRACE to record the teams each decision visits.
  */
 #ifndef {guard}
 #define {guard}
@@ -221,8 +231,7 @@ def source_text(graph: ExportGraph, name: str) -> str:
             " * own, correctly rounded arithmetic, which may differ from the library's in the\n"
             " * last bit) nor rewrite them (pow(x, 0.5) as sqrt(x)). */\n"
             + "\n".join(
-                f"static double (*const volatile mtpg_{f})({'double, double' if f == 'pow' else 'double'}) = {f};"
-                for f in libm
+                f"static double (*const volatile mtpg_{f})({_params(f)}) = {f};" for f in libm
             )
         )
     if used:

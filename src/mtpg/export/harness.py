@@ -37,7 +37,14 @@ DRIVER_SOURCE = r"""/* Driver of an exported mtpg graph: see mtpg.export.harness
 #include <stdlib.h>
 #include <time.h>
 
-#include "@NAME@.h"
+/* The API of the exported code (declared here so that one driver object serves every
+ * exported graph; the exported .c checks its own header). */
+void mtpg_reset(void);
+void mtpg_act(const double obs[2], int *a_d, double *a_c);
+#ifdef MTPG_TRACE
+extern int mtpg_trace_n;
+extern int mtpg_trace_teams[];
+#endif
 
 int main(int argc, char **argv)
 {
@@ -194,6 +201,30 @@ def find_compiler() -> str | None:
     return None
 
 
+def _compiler(compiler: str | None) -> str:
+    cc = compiler or find_compiler()
+    if cc is None:
+        raise RuntimeError("no C compiler found (set CC or install cc/gcc/clang)")
+    return cc
+
+
+def _compile(cmd: list[str]) -> None:
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stdout}{done.stderr}")
+
+
+def compile_driver(
+    out: Path, *, trace: bool = False, opt: str = "-O2", compiler: str | None = None
+) -> Path:
+    """Compiles the driver alone into the object file ``out`` (reusable for every graph)."""
+    source = Path(out).with_suffix(".c")
+    source.write_text(DRIVER_SOURCE, encoding="utf-8")
+    flags = [*STRICT_FLAGS, opt, *(["-DMTPG_TRACE"] if trace else [])]
+    _compile([_compiler(compiler), *flags, "-c", str(source), "-o", str(out)])
+    return Path(out)
+
+
 def build_driver(
     source_dir: Path,
     name: str,
@@ -202,6 +233,7 @@ def build_driver(
     trace: bool = False,
     opt: str = "-O2",
     compiler: str | None = None,
+    driver_object: Path | None = None,
 ) -> Path:
     """Compiles ``name.c`` of ``source_dir`` with the driver into ``exe``.
 
@@ -212,6 +244,8 @@ def build_driver(
         trace: Compile with ``-DMTPG_TRACE``.
         opt: Optimisation flag.
         compiler: Compiler path (default :func:`find_compiler`).
+        driver_object: A driver compiled by :func:`compile_driver` with the same
+            ``trace``; compiled along when None.
 
     Returns:
         ``exe``.
@@ -219,17 +253,14 @@ def build_driver(
     Raises:
         RuntimeError: When no compiler exists or compilation fails (with its output).
     """
-    cc = compiler or find_compiler()
-    if cc is None:
-        raise RuntimeError("no C compiler found (set CC or install cc/gcc/clang)")
     source_dir = Path(source_dir)
-    driver = source_dir / f"{name}_driver.c"
-    driver.write_text(DRIVER_SOURCE.replace("@NAME@", name), encoding="utf-8")
-    cmd = [cc, *STRICT_FLAGS, opt, *(["-DMTPG_TRACE"] if trace else [])]
-    cmd += ["-I", str(source_dir), str(source_dir / f"{name}.c"), str(driver), "-o", str(exe)]
-    done = subprocess.run([*cmd, "-lm"], capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stdout}{done.stderr}")
+    if driver_object is None:
+        driver_object = compile_driver(
+            source_dir / f"{name}_driver.o", trace=trace, opt=opt, compiler=compiler
+        )
+    flags = [*STRICT_FLAGS, opt, *(["-DMTPG_TRACE"] if trace else [])]
+    source = str(source_dir / f"{name}.c")
+    _compile([_compiler(compiler), *flags, source, str(driver_object), "-o", str(exe), "-lm"])
     return Path(exe)
 
 

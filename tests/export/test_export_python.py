@@ -1,6 +1,7 @@
 """The exported Python module equals the engine bit for bit and needs only ``math``."""
 
 import ast
+import importlib.util
 import json
 import subprocess
 import sys
@@ -17,6 +18,7 @@ from export_cases import (
     sequence_stream,
 )
 
+from mtpg.envs.core import TASK_NAMES
 from mtpg.export.common import prepare
 from mtpg.export.harness import Stream, engine_stream
 from mtpg.export.python import module_text, write_python
@@ -90,3 +92,29 @@ def test_memory_persists_across_calls_until_reset(py_runner):
     again = py_runner(pop, root, restarted)
     assert [x[:2] for x in again[40:]] == [x[:2] for x in got[:40]]
     assert [x[:2] for x in again[40:]] != [x[:2] for x in got[40:]]
+
+
+def test_module_plays_a_gymnasium_episode_with_the_engines_return(evolved, tmp_path):
+    import gymnasium as gym
+
+    from mtpg.engine.batch import Episodes, evaluate_roots
+    from mtpg.engine.compile import compile_population
+
+    _, cases = evolved
+    _, pop, root, _ = max(cases, key=lambda c: len(c[1].reachable(c[2])))
+    path = write_python(prepare(pop, root, no_memory=False), tmp_path / "gym_champ.py")
+    spec = importlib.util.spec_from_file_location("gym_champ", path)
+    agent = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(agent)
+    for task in ("Pendulum", "CartPole"):
+        env = gym.make(f"mtpg/{task}-v0")
+        obs, _ = env.reset(seed=SEEDS[0])
+        agent.reset()
+        total, done = 0.0, False
+        while not done:
+            obs, reward, terminated, truncated, _ = env.step(agent.act(obs))
+            total += reward
+            done = terminated or truncated
+        table = Episodes.grid([TASK_NAMES.index(task)], SEEDS)
+        returns, _ = evaluate_roots(compile_population(pop), [root], table)
+        assert total == returns[0, 0]

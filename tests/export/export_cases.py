@@ -12,7 +12,7 @@ from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.envs.core import TASK_NAMES
 from mtpg.export.harness import Stream, mismatches
 from mtpg.model.graph import Population, atomic
-from mtpg.model.instructions import OP_ADD, OP_MUL
+from mtpg.model.instructions import OP_ADD, OP_MUL, RegisterLayout
 
 ALL_TASKS = list(range(len(TASK_NAMES)))
 #: One held-out-style seed per task: a full episode of every task per graph.
@@ -27,6 +27,10 @@ def random_cases():
         rng = np.random.default_rng(seed)
         pop = tangled_population(rng, 8, 24, 16, 3, 0.6)
         cases.append((f"tangled-{seed}", pop, int(rng.choice(list(pop.teams)))))
+    rng = np.random.default_rng(14)
+    small = RegisterLayout(n_registers=3, n_memory=2)
+    pop = tangled_population(rng, 6, 16, 12, 2, 0.5, layout=small)
+    cases.append(("tangled-R3-M2", pop, int(rng.choice(list(pop.teams)))))
     pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=4, programs=6, instructions=12)
     cases += [(f"layered-{r}", pop, r) for r in roots]
     return cases

@@ -86,16 +86,21 @@ def test_generated_code_depends_on_math_h_only_and_drops_introns_and_unreachable
     graph = prepare(pop, root, no_memory=False, source="g.json", meta={"generation": 7})
     header, source = write_c(graph, tmp_path, "champ")
     c, h = source.read_text(), header.read_text()
+    again = write_c(graph, tmp_path / "again", "champ")
+    assert [p.read_text() for p in again] == [h, c]  # deterministic output
     assert re.findall(r"#include\s*(\S+)", c) == ["<math.h>", '"champ.h"']
     assert "#include" not in h
     reachable = pop.reachable(root)
     assert f"#define MTPG_N_TEAMS {len(reachable)}" in h
     ids = re.search(r"mtpg_team_ids\[MTPG_N_TEAMS\] = \{(.*)\}", c).group(1)
     assert [int(x) for x in ids.split(",")] == reachable
-    # one generated statement per effective instruction; introns are gone
-    statements = re.findall(r"^    \S+ = mtpg_op_\w+\(", c, flags=re.M)
-    assert len(statements) == graph.n_instructions
-    assert graph.n_introns > 0
+    # introns are gone; of the effective instructions, those evaluated at export time are
+    # gone too unless they write memory (then they are stores of literals)
+    statements = re.findall(r"^    [rm]\[\d+\] = ", c, flags=re.M)
+    assert len(statements) == graph.n_statements
+    stores = re.findall(r"^    m\[\d+\] = [-(\d]", c, flags=re.M)
+    assert graph.n_statements == graph.n_instructions - graph.n_folded + len(stores)
+    assert graph.n_introns > 0 and graph.n_folded > 0
     total = sum(len(pop.programs[p.id].instructions) for p in graph.programs)
     assert graph.n_instructions + graph.n_introns == total
 

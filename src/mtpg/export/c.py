@@ -29,7 +29,8 @@ engine ran with (the same libm; other libms may differ in the last bit).
 
 from __future__ import annotations
 
-from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, op_name
+from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram
+from mtpg.export.fold import Operand
 
 #: C library functions that are not correctly rounded, by the ops calling them. They are
 #: called through volatile pointers so that no compiler can evaluate them at compile time
@@ -91,45 +92,37 @@ def _comment(lines: list[tuple[str, str]], indent: str = " * ") -> str:
     )
 
 
-def _operand(graph: ExportGraph, index: int) -> str:
-    kind, value = graph.operand(int(index))
-    if kind == "c":
-        return _literal(float(value))
-    return f"{kind}[{value}]"
+def _operand(operand: Operand) -> str:
+    kind, value = operand
+    return _literal(float(value)) if kind == "c" else f"{kind}[{value}]"
 
 
 def _program_function(graph: ExportGraph, k: int, prog: ExportProgram) -> str:
     """The ``static double mtpg_pK(const double *s)`` function of one program."""
     lines = []
-    uses_m = graph.no_memory
-    uses_s = False
-    for op, dst, a, b in prog.code.tolist():
-        name = op_name(op)
-        args = [_operand(graph, b)]
-        if name in ("add", "sub", "mul", "div", "pow"):
-            args.insert(0, _operand(graph, a))
-        elif name in ("if_lt", "if_gt"):
-            args[:0] = [_operand(graph, dst), _operand(graph, a)]
-        target = _operand(graph, dst)
-        call = f"mtpg_op_{name}({', '.join(args)})"
-        lines.append(f"    {target} = {call};")
-        text = target + call
-        uses_m = uses_m or "m[" in text
-        uses_s = uses_s or "s[" in text
+    for st in prog.body:
+        value = (
+            _operand(st.args[0])
+            if st.op is None
+            else f"mtpg_op_{st.op}({', '.join(_operand(x) for x in st.args)})"
+        )
+        lines.append(f"    {_operand(st.target)} = {value};")
+    kinds = {x[0] for st in prog.body for x in (st.target, *st.args)} | {prog.bid[0]}
     head = [
-        f"/* program {prog.id}: bank {graph.bank_ids[prog.bank]}, "
-        f"{len(prog.code)} of {prog.n_total} instructions */",
+        f"/* program {prog.id}: bank {graph.bank_ids[prog.bank]}, {len(prog.code)} of "
+        f"{prog.n_total} instructions effective, {prog.folded} evaluated at export time */",
         f"static double mtpg_p{k}(const double *s)",
         "{",
-        f"    double r[{graph.layout.n_registers}] = {{0.0}};",
     ]
-    if uses_m:
+    if "r" in kinds:
+        head.append(f"    double r[{graph.layout.n_registers}] = {{0.0}};")
+    if "m" in kinds or graph.no_memory:
         head.append(f"    double *m = mtpg_mem[{prog.bank}];")
-    if not uses_s:
+    if "s" not in kinds:
         head.append("    (void)s;")
     if graph.no_memory:
         head.append("    mtpg_zero_bank(m); /* memory off: the bank is zeroed before every run */")
-    return "\n".join(head + lines + ["    return r[0];", "}"])
+    return "\n".join(head + lines + [f"    return {_operand(prog.bid)};", "}"])
 
 
 def _team_case(graph: ExportGraph, t: int) -> str:
@@ -204,7 +197,7 @@ extern int mtpg_trace_teams[MTPG_N_TEAMS];
 
 def source_text(graph: ExportGraph, name: str) -> str:
     """The ``.c`` file: protected operations, programs, ``mtpg_reset`` and ``mtpg_act``."""
-    used = sorted({op_name(op) for p in graph.programs for op in p.code[:, 0].tolist()})
+    used = sorted({st.op for p in graph.programs for st in p.body if st.op is not None})
     consts = "\n".join(
         f"#define MTPG_{key} {_literal(value)}" for key, value in TABLE_CONSTANTS.items()
     )

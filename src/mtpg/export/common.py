@@ -27,14 +27,13 @@ from typing import Any
 
 import numpy as np
 
+from mtpg.export.fold import Operand, Statement, lower
 from mtpg.model.graph import Population
 from mtpg.model.instructions import (
     BIG,
-    CONSTANTS,
     DIV_EPS,
     LOG_BIG,
     LOG_TINY,
-    OP_NAMES,
     RegisterLayout,
     effective_mask,
 )
@@ -61,6 +60,9 @@ class ExportProgram:
         n_total: Instructions before intron removal.
         bank: Dense bank index.
         target: Dense team index it points to, or ``-1 - a`` for atomic action ``a``.
+        body: The statements to generate (:func:`mtpg.export.fold.lower`).
+        bid: The bid operand: ``("r", 0)`` or a literal ``("c", value)``.
+        folded: Effective instructions evaluated at export time.
     """
 
     id: int
@@ -68,6 +70,9 @@ class ExportProgram:
     n_total: int
     bank: int
     target: int
+    body: list[Statement]
+    bid: Operand
+    folded: int
 
     @property
     def is_atomic(self) -> bool:
@@ -103,27 +108,26 @@ class ExportGraph:
         return sum(len(p.code) for p in self.programs)
 
     @property
+    def n_folded(self) -> int:
+        """Effective instructions evaluated at export time."""
+        return sum(p.folded for p in self.programs)
+
+    @property
+    def n_statements(self) -> int:
+        """Assignments in the generated code."""
+        return sum(len(p.body) for p in self.programs)
+
+    @property
     def n_introns(self) -> int:
         """Instructions removed as introns."""
         return sum(p.n_total - len(p.code) for p in self.programs)
-
-    def operand(self, index: int) -> tuple[str, int | float]:
-        """Classifies a logical operand: ``("r"|"m"|"s", index)`` or ``("c", value)``."""
-        lay = self.layout
-        if index < lay.mem_start:
-            return "r", int(index)
-        if index < lay.const_start:
-            return "m", int(index - lay.mem_start)
-        if index < lay.obs_start:
-            return "c", float(CONSTANTS[index - lay.const_start])
-        return "s", int(index - lay.obs_start)
 
     def summary(self) -> str:
         """One line: teams, programs, banks, instructions and introns removed."""
         return (
             f"{len(self.teams)} teams, {len(self.programs)} programs, {len(self.bank_ids)} "
             f"memory banks, {self.n_instructions} instructions ({self.n_introns} introns "
-            f"removed)"
+            f"removed; {self.n_folded} evaluated at export time)"
         )
 
 
@@ -170,8 +174,11 @@ def prepare(
         code = np.asarray(prog.instructions, dtype=np.int64)
         code = code[effective_mask(prog.instructions, layout)]
         target = prog.action if prog.is_atomic else team_index[prog.action]
+        body, bid, folded = lower(code, layout, no_memory)
         programs.append(
-            ExportProgram(pid, code, len(prog.instructions), bank_index[prog.bank], target)
+            ExportProgram(
+                pid, code, len(prog.instructions), bank_index[prog.bank], target, body, bid, folded
+            )
         )
     teams = [[prog_index[pid] for pid in pop.teams[tid].programs] for tid in team_ids]
     meta = dict(meta or {})
@@ -193,8 +200,3 @@ def prepare(
     graph = ExportGraph(layout, team_ids, teams, programs, bank_ids, no_memory, provenance)
     graph.provenance.append(("graph", graph.summary()))
     return graph
-
-
-def op_name(op: int) -> str:
-    """Name of an op code (as in :data:`mtpg.model.instructions.OP_NAMES`)."""
-    return OP_NAMES[int(op)]

@@ -145,6 +145,12 @@ def _team_case(graph: ExportGraph, t: int) -> str:
     return "\n".join(lines)
 
 
+def _memory_phrase(graph: ExportGraph) -> str:
+    if graph.no_memory:
+        return "Memory off: each program zeroes its bank before it runs"
+    return "Memory persists between calls"
+
+
 def header_text(graph: ExportGraph, name: str) -> str:
     """The ``.h`` file: API, sizes, provenance and the bit-identity conditions."""
     guard = "".join(ch if ch.isalnum() else "_" for ch in name).upper() + "_H"
@@ -153,8 +159,8 @@ def header_text(graph: ExportGraph, name: str) -> str:
 {_comment(graph.provenance)}
  *
  * API: call mtpg_reset() at the start of every episode (it zeroes all memory banks),
- * then mtpg_act() once per step; memory persists between calls. The state is static:
- * one agent per program (not reentrant).
+ * then mtpg_act() once per step. The state is static: one agent per program (not
+ * reentrant). {_memory_phrase(graph)}.
  *
  * Bit-identity: compiled as C99 with IEEE double arithmetic and WITHOUT floating-point
  * contraction (gcc/clang: -ffp-contract=off; never -ffast-math), every a_d and a_c equals

@@ -5,23 +5,21 @@ The generated API::
     void mtpg_reset(void);                                    /* zero all banks */
     void mtpg_act(const double obs[2], int *a_d, double *a_c); /* one decision */
 
-Each program becomes a ``static`` function of straight-line code (introns already
-removed) that runs on a ``static`` array of memory banks, so memory persists between
-calls until ``mtpg_reset``. Each team becomes a ``case`` of a loop in ``mtpg_act`` that
-runs all its programs in order and keeps the first highest bid among eligible programs,
-as the engine does. Compiled with ``-DMTPG_TRACE``, ``mtpg_act`` also records the teams
-it visits.
+Each program becomes a ``static`` function of straight-line code (introns removed,
+values known at export time substituted, see :mod:`mtpg.export.fold`) that runs on a
+``static`` array of memory banks, so memory persists between calls until ``mtpg_reset``.
+Each team becomes a ``case`` of a loop in ``mtpg_act`` that runs all its programs in order
+and keeps the first highest bid among eligible programs, as the engine does. Compiled
+with ``-DMTPG_TRACE``, ``mtpg_act`` also records the teams it visits.
 
 Bit-identity: every protected operation is written as the engine's table
 (:func:`mtpg.engine.ops.apply_op`), calling the same C library functions (``log``,
 ``pow``, ``exp``, ``cos``, ``sin``, ``tanh``, ``sqrt``) in the same order and clamping in
-the same way, and constants are printed as shortest round-trip decimals. The generated
-code is specialised to one graph, so many arguments are known at compile time (private
-registers start at 0, constants are literals): the functions that are not correctly
-rounded are therefore called through ``volatile`` pointers, which stops compilers from
-evaluating them with their own (correctly rounded) arithmetic, a difference in the last
-bit that the tests did catch. With IEEE double
-arithmetic (SSE2 or any FPU without extended precision) and no floating-point contraction
+the same way; literals are printed as shortest round-trip decimals. The functions that
+are not correctly rounded are called through ``volatile`` pointers, so no compiler can
+evaluate them at compile time with its own (correctly rounded) arithmetic: the last-bit
+difference that caused is what the tests first caught. With IEEE double arithmetic (SSE2
+or any FPU without extended precision) and no floating-point contraction
 (``-ffp-contract=off``; no ``-ffast-math``), results equal the engine's bit for bit as
 long as the C library's ``log``/``pow``/``exp``/``cos``/``sin``/``tanh`` are the ones the
 engine ran with (the same libm; other libms may differ in the last bit).

@@ -124,3 +124,17 @@ def test_header_states_api_provenance_and_bit_identity_conditions():
     assert "mtpg_zero_bank(m); /* memory off" in source_text(graph, "champ")
     on = source_text(prepare(pop, root, no_memory=False), "champ")
     assert "mtpg_zero_bank(m)" not in on
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(20))
+def test_many_random_graphs_match_the_engine(c_runner, py_runner, seed):
+    rng = np.random.default_rng(1000 + seed)
+    pop = tangled_population(rng, 10, 40, 30, 5, [0.3, 0.6, 0.9][seed % 3])
+    root = int(rng.choice(list(pop.teams)))
+    for no_memory in (False, True):
+        stream = engine_stream(pop, root, ALL_TASKS, SEEDS, no_memory)
+        assert_same(stream, c_runner(pop, root, stream, no_memory, trace=True))
+        assert_same(stream, py_runner(pop, root, stream, no_memory))
+        extreme = sequence_stream(pop, root, 300, seed, no_memory)
+        assert_same(extreme, c_runner(pop, root, extreme, no_memory), teams=False)

@@ -44,7 +44,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--bench-runs", type=int, default=5, help="timed runs; fastest counts (5)")
     p.add_argument("--tasks", help="comma-separated benchmark tasks (default: the graph's)")
-    p.add_argument("--json", action="store_true", help="print the benchmark as one JSON object")
+    p.add_argument(
+        "--json", action="store_true", help="print the benchmark as one JSON object (last line)"
+    )
     p.set_defaults(func=run)
 
 

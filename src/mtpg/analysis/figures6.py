@@ -22,7 +22,7 @@ DPI = 110
 
 
 def pyplot():
-    """matplotlib's pyplot on the file-only Agg backend."""
+    """The pyplot module of matplotlib, on the file-only Agg backend."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -48,12 +48,12 @@ def team_graph(layout: GraphLayout, visits: dict, path: Path, title: str) -> Pat
     """Fig. 9 top: the team graph, each team a pie of its visit rate in each task."""
     plt = pyplot()
     tasks = [str(t) for t in visits["tasks"]]
-    width = max(6.0, min(16.0, 1.6 * (np.ptp(layout.pos[:, 0]) + 2)))
+    width = max(7.0, min(16.0, 1.6 * (np.ptp(layout.pos[:, 0]) + 2)))
     height = max(3.5, min(14.0, 1.4 * (np.ptp(layout.pos[:, 1]) + 2))) + 1.2
     fig, ax = plt.subplots(figsize=(width, height))
     GraphDrawing(ax, layout, visits["pie"], [task_colour(t) for t in tasks])
     ax.set_title(title, fontsize=11)
-    _task_legend(fig, tasks, loc="lower center", ncol=min(6, len(tasks)), fontsize=8)
+    _task_legend(fig, tasks, loc="lower center", ncol=min(3, len(tasks)), fontsize=8)
     fig.text(
         0.01,
         0.99,
@@ -63,7 +63,7 @@ def team_graph(layout: GraphLayout, visits: dict, path: Path, title: str) -> Pat
         fontsize=7,
         color="0.3",
     )
-    fig.tight_layout(rect=(0, 0.07, 1, 0.93))
+    fig.tight_layout(rect=(0, 0.1, 1, 0.93))
     return _save(fig, path)
 
 
@@ -117,7 +117,9 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
         axes[2].plot(steps[has], series["newest"][has], ".", ms=2, color="0.6", label="newest")
         axes[2].legend(fontsize=7, loc="upper left")
     else:
-        axes[2].text(0.5, 0.5, "no memory read", ha="center", transform=axes[2].transAxes)
+        axes[2].text(
+            0.5, 0.5, "no written memory value read", ha="center", transform=axes[2].transAxes
+        )
     axes[2].set_ylabel("memory window\n(age of values read,\nsteps)")
     ax = axes[3]
     ax.plot(steps, prediction["velocity"], color="black", lw=1.2, label=prediction["variable"])
@@ -149,7 +151,12 @@ def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path
     cols = min(4, max(1, len(teams)))
     rows = -(-len(teams) // cols)
     fig, axes = plt.subplots(
-        rows, cols, figsize=(3.2 * cols, 2.8 * rows + 1.0), squeeze=False, sharex=True, sharey=True
+        rows,
+        cols,
+        figsize=(3.3 * cols + 2.2, 2.9 * rows + 1.3),
+        squeeze=False,
+        sharex=True,
+        sharey=True,
     )
     all_actions = np.concatenate([t["action"][t["final"]] for t in teams] + [np.zeros(0)])
     lo, hi = (all_actions.min(), all_actions.max()) if len(all_actions) else (-1.0, 1.0)
@@ -188,26 +195,24 @@ def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path
     for ax in axes[:, 0]:
         ax.set_ylabel(dec["y_label"], fontsize=8)
     fig.suptitle(title, fontsize=11)
+    passed_handle = Line2D([], [], ls="", marker="o", color=PASSED_COLOUR, label="passed on")
     if dec["continuous"] and mappable is not None:
-        fig.tight_layout(rect=(0, 0, 0.9, 0.95))
-        cax = fig.add_axes((0.92, 0.15, 0.015, 0.7))
-        fig.colorbar(mappable, cax=cax, label="a_c of the step (final team)")
-        fig.legend(
-            handles=[Line2D([], [], ls="", marker="o", color=PASSED_COLOUR, label="passed on")],
-            loc="upper right",
-            fontsize=7,
-        )
+        handles = [passed_handle]
     else:
         handles = [
-            Line2D([], [], ls="", marker="o", color=c, label=f"final, a_d = {a}")
+            Line2D([], [], ls="", marker="o", color=c, label=f"final team, a_d = {a}")
             for a, c in enumerate(ACTION_COLOURS)
-        ] + [Line2D([], [], ls="", marker="o", color=PASSED_COLOUR, label="passed on")]
-        fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=7)
-        fig.tight_layout(rect=(0, 0.06, 1, 0.95))
+        ] + [passed_handle]
+    fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8)
+    bottom = 0.9 / (2.9 * rows + 1.3)
+    fig.tight_layout(rect=(0, bottom, 0.86, 0.95))
+    if dec["continuous"] and mappable is not None:
+        cax = fig.add_axes((0.89, 0.2, 0.02, 0.6))
+        fig.colorbar(mappable, cax=cax, label="a_c of the step (coloured: final team)")
     return _save(fig, path)
 
 
-def run_hierarchy(stats: dict, medians: dict, path: Path, title: str) -> Path:
+def run_hierarchy(stats: dict, means: dict, path: Path, title: str) -> Path:
     """Fig. 8 across a run: teams per decision of every subset champion, by subset size."""
     plt = pyplot()
     fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
@@ -220,11 +225,11 @@ def run_hierarchy(stats: dict, medians: dict, path: Path, title: str) -> Path:
     a.set_title(f"Subset champions at generation {int(stats['final_generation'])}", fontsize=10)
     a.set_xticks(np.unique(stats["subset_size"]))
     cmap = plt.get_cmap("viridis")
-    n = len(medians["sizes"])
-    for i, size in enumerate(medians["sizes"]):
+    n = len(means["sizes"])
+    for i, size in enumerate(means["sizes"]):
         b.plot(
-            medians["generations"],
-            medians["median"][i],
+            means["generations"],
+            means["mean"][i],
             color=cmap(i / max(n - 1, 1)),
             marker=".",
             label=f"{size} task{'s' if size > 1 else ''}",
@@ -238,7 +243,7 @@ def run_hierarchy(stats: dict, medians: dict, path: Path, title: str) -> Path:
             label="whole population (training)",
         )
     b.set_xlabel("generation")
-    b.set_ylabel("teams visited per decision\n(median over subset champions)")
+    b.set_ylabel("teams visited per decision\n(mean over subset champions)")
     b.set_title("Over the run, by subset size", fontsize=10)
     b.legend(fontsize=7, ncol=2)
     fig.suptitle(title, fontsize=11)

@@ -111,7 +111,7 @@ def describe_graph(pop: Population, root: int, meta: dict | None = None) -> str:
         int(effective_mask(pop.programs[p].instructions, layout).sum()) for p in index.programs
     )
     lines = [
-        f"graph: {len(index.teams)} teams, {len(index.programs)} programs, "
+        f"graph: {len(index.teams)} team(s), {len(index.programs)} programs, "
         f"{len(index.banks)} memory banks of {layout.n_memory} registers, "
         f"{n_instr} instructions ({n_eff} effective, {n_instr - n_eff} introns)",
         "numbers: team N is the N-th team in depth-first order from the root (team 1); "
@@ -139,7 +139,7 @@ def describe_graph(pop: Population, root: int, meta: dict | None = None) -> str:
             for j, (text, live) in enumerate(
                 zip(disassemble(prog.instructions, layout), mask, strict=True)
             ):
-                lines.append(f"    {j:3d}  {text:<34}{'' if live else '  intron'}")
+                lines.append(f"    {j:3d}  {text:<34}{'' if live else '  intron'}".rstrip())
     users = bank_users(pop, index)
     shared = {b: u for b, u in users.items() if len(u) > 1}
     lines.append("")

@@ -55,18 +55,16 @@ def hierarchy_statistics(run_dir: str | Path) -> dict[str, np.ndarray]:
     metrics = run_dir / METRICS_FILE
     mrows = _read(metrics) if metrics.is_file() else []
     out["generation"] = np.array([float(r["generation"]) for r in mrows])
-    out["population_teams_per_decision"] = np.array(
-        [float(r["teams_per_decision"]) for r in mrows]
-    )
+    out["population_teams_per_decision"] = np.array([float(r["teams_per_decision"]) for r in mrows])
     out["champion_teams"] = np.array([float(r["champion_teams"]) for r in mrows])
     return out
 
 
-def median_by_size(stats: dict[str, np.ndarray], key: str = "teams_per_decision") -> dict:
-    """Median of ``key`` over the subset champions of each size at each test point.
+def mean_by_size(stats: dict[str, np.ndarray], key: str = "teams_per_decision") -> dict:
+    """Mean of ``key`` over the subset champions of each size at each test point.
 
     Returns:
-        ``sizes`` (S,), ``generations`` (G,), ``median`` (S, G).
+        ``sizes`` (S,), ``generations`` (G,), ``mean`` (S, G).
     """
     sizes = np.unique(stats["subset_size"])
     gens = np.unique(stats["test_generation"])
@@ -75,5 +73,5 @@ def median_by_size(stats: dict[str, np.ndarray], key: str = "teams_per_decision"
         for j, g in enumerate(gens):
             sel = (stats["subset_size"] == s) & (stats["test_generation"] == g)
             if sel.any():
-                med[i, j] = np.median(stats[key][sel])
-    return {"sizes": sizes, "generations": gens, "median": med}
+                med[i, j] = np.mean(stats[key][sel])
+    return {"sizes": sizes, "generations": gens, "mean": med}

@@ -117,8 +117,10 @@ def step_series(replay: Replay, episode: int = 0) -> dict[str, np.ndarray]:
     Returns:
         ``step`` (n,), ``teams`` teams visited, ``instructions`` instructions executed,
         ``newest`` and ``oldest`` the smallest and largest age (steps since written, see the
-        replay schema) of any memory value read at the step (NaN: no memory read),
-        ``reads`` memory reads.
+        replay schema) of the memory values read at the step that were written in this
+        episode (NaN: none; a read of a register still holding its reset 0 carries no
+        information from the past, so it does not widen the window), ``reads`` memory
+        reads (all of them).
     """
     sl = replay.episode_slice(episode)
     n = sl.stop - sl.start
@@ -127,13 +129,14 @@ def step_series(replay: Replay, episode: int = 0) -> dict[str, np.ndarray]:
     off = replay["mem_offsets"]
     ages = replay["mem_age"]
     reads = ~replay["mem_is_write"]
+    remembered = reads & ~replay["mem_from_reset"]
     newest = np.full(n, np.nan)
     oldest = np.full(n, np.nan)
     n_reads = np.zeros(n, dtype=np.int64)
     for i in range(n):
         lo, hi = off[sl.start + i], off[sl.start + i + 1]
-        a = ages[lo:hi][reads[lo:hi]]
-        n_reads[i] = len(a)
+        a = ages[lo:hi][remembered[lo:hi]]
+        n_reads[i] = int(reads[lo:hi].sum())
         if len(a):
             newest[i], oldest[i] = a.min(), a.max()
     return {

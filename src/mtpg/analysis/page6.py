@@ -1,5 +1,7 @@
-"""``mtpg analyze``: the section-6 figures of one graph as PNG files, a JSON summary and
-one self-contained HTML page (images embedded)."""
+"""``mtpg analyze``: the section-6 figures of one graph, a JSON summary and an HTML page.
+
+The page is self-contained: its images are embedded.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ from mtpg.analysis import figures6
 from mtpg.analysis.decompose import decomposition
 from mtpg.analysis.graphinfo import graph_dot, index_graph
 from mtpg.analysis.graphlayout import layout_graph, render_svg
-from mtpg.analysis.hierarchy import hierarchy_statistics, median_by_size
+from mtpg.analysis.hierarchy import hierarchy_statistics, mean_by_size
 from mtpg.analysis.inside import (
     register_access,
     step_series,
@@ -65,8 +67,10 @@ def build_analysis(
     run_dir: str | Path | None = None,
     label: str = "graph",
 ) -> dict[str, Path]:
-    """Replays every task and writes the figures, ``graph.dot``, ``analysis.json`` and
-    ``index.html`` into ``out``.
+    """Replays every task and writes the figures and the page into ``out``.
+
+    Besides the PNG figures: ``graph.dot`` (and ``graph.svg`` when GraphViz is installed),
+    ``analysis.json`` (the numbers of the page) and ``index.html``.
 
     Args:
         pop: The population holding the graph.
@@ -103,14 +107,14 @@ def build_analysis(
         layout,
         visits,
         out / "team_graph.png",
-        f"{label}: {n_teams} teams, visits over {episodes} test episodes per task ({mem})",
+        f"{label}: {n_teams} team{'s' if n_teams > 1 else ''}, visits over {episodes} "
+        f"test episodes per task ({mem})",
     )
     sections.append(_img(files["team_graph"], "Team graph with visits by task (Fig. 9 top)"))
     files["registers"] = figures6.register_access(
         access,
         out / "register_access.png",
-        f"{label}: share of accesses of the {len(access['labels'])} memory registers used, "
-        "by task",
+        f"{label}: share of accesses of the {len(access['labels'])} memory registers used, by task",
     )
     sections.append(_img(files["registers"], "Memory register access by task (Fig. 9 bottom)"))
     summary: dict[str, object] = {
@@ -161,7 +165,7 @@ def build_analysis(
         stats = hierarchy_statistics(run_dir)
         files["hierarchy"] = figures6.run_hierarchy(
             stats,
-            median_by_size(stats),
+            mean_by_size(stats),
             out / "run_hierarchy.png",
             f"{Path(run_dir).name}: hierarchical complexity of task-subset champions",
         )

@@ -44,6 +44,8 @@ mem_age                (A,)        steps since the value read (or overwritten) w
                                    the episode start counts as written at step -1 (age
                                    ``t + 1``); with memory off every value is reset before
                                    each program, so ages are 0. ``mem_offsets`` (N+1,)
+mem_from_reset         (A,)        True when the value had not been written in the episode
+                                   (it is the reset 0)
 =====================  ==========  ===========================================================
 """
 
@@ -68,7 +70,7 @@ RAGGED = {
     "visit": ("visit_team",),
     "exec": ("exec_program", "exec_bid"),
     "instr": ("instr_program", "instr_position"),
-    "mem": ("mem_bank", "mem_register", "mem_is_write", "mem_age"),
+    "mem": ("mem_bank", "mem_register", "mem_is_write", "mem_age", "mem_from_reset"),
 }
 
 
@@ -219,6 +221,7 @@ def replay_task(
         add("mem_register", log[:, 2])
         add("mem_is_write", log[:, 3].astype(bool))
         add("mem_age", age.astype(np.int64))
+        add("mem_from_reset", last < 0)
         add("mem_offsets", _offsets(t, n))
     data: dict[str, np.ndarray] = {
         "schema_version": np.array(SCHEMA_VERSION),
@@ -266,6 +269,4 @@ def replay_tasks(
     memory_episodes: int | None = None,
 ) -> dict[str, Replay]:
     """:func:`replay_task` for several tasks, by task name in the order given."""
-    return {
-        t: replay_task(pop, root, t, episodes, seed, no_memory, memory_episodes) for t in tasks
-    }
+    return {t: replay_task(pop, root, t, episodes, seed, no_memory, memory_episodes) for t in tasks}

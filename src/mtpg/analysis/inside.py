@@ -185,10 +185,11 @@ def best_register(velocity: np.ndarray, memory: np.ndarray) -> tuple[int, float]
 def scale_pm1(x: np.ndarray) -> np.ndarray:
     """Linearly maps ``x`` onto [-1, 1] (a constant maps to 0)."""
     x = np.asarray(x, dtype=np.float64)
-    lo, hi = x.min(initial=0.0), x.max(initial=0.0)
-    if len(x) == 0 or hi == lo:
-        return np.zeros_like(x)
+    if len(x) == 0:
+        return x.copy()
     lo, hi = x.min(), x.max()
+    if hi == lo:
+        return np.zeros_like(x)
     return 2.0 * (x - lo) / (hi - lo) - 1.0
 
 

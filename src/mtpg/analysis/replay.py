@@ -57,8 +57,8 @@ from pathlib import Path
 import numpy as np
 
 from mtpg.analysis.graphinfo import effective_instruction_map, index_graph
-from mtpg.engine.compile import compile_population
-from mtpg.engine.trace import trace_episode
+from mtpg.engine.compile import CompiledPopulation, compile_population
+from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs import make_episodes
 from mtpg.envs.core import TASK_NAMES
 from mtpg.evolve.trainer import test_seeds
@@ -166,8 +166,45 @@ def replay_task(
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     task_id = TASK_NAMES.index(task)
-    index = index_graph(pop, root)
     cp = compile_population(pop)
+    seeds = test_seeds(episodes, seed)
+    starts, noise = make_episodes(np.full(episodes, task_id), seeds)
+    n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
+    traces = [
+        trace_episode(
+            cp, root, task_id, starts[e], noise[e], no_memory=no_memory, snapshot=e < n_mem_eps
+        )
+        for e in range(episodes)
+    ]
+    header = {"task": task, "task_id": task_id, "seed": seed, "episode_seeds": seeds}
+    return _assemble(pop, root, cp, traces, header, no_memory, n_mem_eps)
+
+
+def replay_observations(
+    pop: Population, root: int, observations: np.ndarray, no_memory: bool = False
+) -> Replay:
+    """Traces the graph's decisions on a given input sequence ``(n, 2)`` (one "episode").
+
+    No task runs: ``task`` is empty, ``task_id`` -1, hidden states and rewards are 0.
+    Useful to probe a graph with inputs of one's own making.
+    """
+    cp = compile_population(pop)
+    trace = trace_sequence(cp, root, observations, no_memory=no_memory, snapshot=True)
+    header = {"task": "", "task_id": -1, "seed": 0, "episode_seeds": np.zeros(1, np.int64)}
+    return _assemble(pop, root, cp, [trace], header, no_memory, 1)
+
+
+def _assemble(
+    pop: Population,
+    root: int,
+    cp: CompiledPopulation,
+    traces: list[Trace],
+    header: dict,
+    no_memory: bool,
+    n_mem_eps: int,
+) -> Replay:
+    """Joins traced episodes into the arrays of the schema, with graph numbering."""
+    index = index_graph(pop, root)
     m = pop.layout.n_memory
     team_number = np.zeros(len(cp.team_ids), dtype=np.int64)
     for k, tid in enumerate(index.teams):
@@ -180,19 +217,13 @@ def replay_task(
         columns.extend(range(dense * m, (dense + 1) * m))
     columns = np.array(columns, dtype=np.int64)
     instr_prog, instr_pos = effective_instruction_map(pop, cp.program_ids)
-    seeds = test_seeds(episodes, seed)
-    starts, noise = make_episodes(np.full(episodes, task_id), seeds)
-    n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
     parts: dict[str, list[np.ndarray]] = {}
 
     def add(key: str, value: np.ndarray) -> None:
         parts.setdefault(key, []).append(value)
 
     returns, lengths, finals = [], [], []
-    for e in range(episodes):
-        tr = trace_episode(
-            cp, root, task_id, starts[e], noise[e], no_memory=no_memory, snapshot=e < n_mem_eps
-        )
+    for e, tr in enumerate(traces):
         n = len(tr.actions)
         lengths.append(n)
         returns.append(float(sum(tr.rewards.tolist(), 0.0)))  # the kernel's summation order
@@ -225,18 +256,18 @@ def replay_task(
         add("mem_offsets", _offsets(t, n))
     data: dict[str, np.ndarray] = {
         "schema_version": np.array(SCHEMA_VERSION),
-        "task": np.array(task),
-        "task_id": np.array(task_id),
+        "task": np.array(header["task"]),
+        "task_id": np.array(header["task_id"]),
         "root_team": np.array(root),
         "no_memory": np.array(bool(no_memory)),
-        "seed": np.array(seed),
+        "seed": np.array(header["seed"]),
         "team_ids": np.array(index.teams, dtype=np.int64),
         "bank_ids": np.array(index.banks, dtype=np.int64),
         "n_memory": np.array(m),
-        "episode_seeds": seeds.astype(np.int64),
+        "episode_seeds": np.asarray(header["episode_seeds"], dtype=np.int64),
         "returns": np.array(returns),
         "episode_offsets": np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64),
-        "final_state": np.array(finals).reshape(episodes, -1),
+        "final_state": np.array(finals).reshape(len(traces), -1),
         "memory_episodes": np.array(n_mem_eps),
     }
     for key, chunks in parts.items():

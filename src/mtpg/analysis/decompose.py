@@ -14,7 +14,7 @@ import numpy as np
 from mtpg.analysis.inside import HIDDEN_VELOCITY, VELOCITY_NAME
 from mtpg.analysis.replay import Replay
 from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.tasks import OBSERVED, USES_CONTINUOUS
+from mtpg.envs.tasks import ACTION_BOUND, OBSERVED, USES_CONTINUOUS
 
 
 def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
@@ -26,8 +26,9 @@ def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
 
     Returns:
         ``teams``: a list over team numbers 1..n_teams of dicts with ``x``, ``y``, ``final``
-        (bool) and ``action`` (the action of the step: ``a_c`` for a continuous task, else
-        ``a_d``) arrays; ``continuous`` (bool), ``x_label``, ``y_label``.
+        (bool) and ``action`` (the action of the step: for a continuous task ``a_c``
+        clipped to the task's bound, as the task applies it, else ``a_d``) arrays;
+        ``continuous`` (bool), ``x_label``, ``y_label``.
     """
     task = replay.task
     task_id = TASK_NAMES.index(task)
@@ -38,7 +39,8 @@ def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
     last_visit[replay["visit_offsets"][1:] - 1] = True
     x = replay["observation"][:, 0]
     y = replay["hidden_state"][:, HIDDEN_VELOCITY[task]]
-    action = replay["a_c"] if continuous else replay["a_d"].astype(np.float64)
+    bound = float(ACTION_BOUND[task_id])
+    action = np.clip(replay["a_c"], -bound, bound) if continuous else replay["a_d"] * 1.0
     teams = []
     for number in range(1, n_teams + 1):
         sel = replay["visit_team"] == number

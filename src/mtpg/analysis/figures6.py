@@ -58,7 +58,8 @@ def team_graph(layout: GraphLayout, visits: dict, path: Path, title: str) -> Pat
         0.01,
         0.99,
         "pie slice: share of the task's steps in which the team ran (normalised over tasks)\n"
-        "root = team 1 (top); rows are depths; arrows: program pointers",
+        "root = team 1 (top); rows are depths; arrows: program pointers; "
+        "dashed: never visited",
         va="top",
         fontsize=7,
         color="0.3",
@@ -89,11 +90,11 @@ def register_access(access: dict, path: Path, title: str) -> Path:
     step = max(1, n // 60)
     ax.set_xticks(np.arange(0, n, step))
     ax.set_xticklabels(access["labels"][::step], rotation=90, fontsize=6)
-    ax.set_xlabel("memory register (bank b, register m), ordered by dominant task")
+    ax.set_xlabel("memory register (bank b, register m), from most specialised to most shared")
     ax.set_ylabel("share of accesses\n(read or write, per step)")
     ax.set_title(title, fontsize=11)
-    ax.legend(fontsize=7, ncol=min(6, len(tasks)), loc="upper center", bbox_to_anchor=(0.5, -0.45))
-    fig.tight_layout()
+    fig.legend(*ax.get_legend_handles_labels(), fontsize=7, ncol=len(tasks), loc="lower center")
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
     return _save(fig, path)
 
 

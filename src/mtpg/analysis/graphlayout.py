@@ -94,26 +94,35 @@ class GraphDrawing:
         for a, b in layout.edges:
             p, q = layout.pos[a - 1], layout.pos[b - 1]
             upward = layout.depth[b - 1] <= layout.depth[a - 1]
+            rad = 0.35 if upward else 0.0
+            start, end = _ends(p, q, r, rad)
             arrow = FancyArrowPatch(
-                tuple(p),
-                tuple(q),
+                start,
+                end,
                 arrowstyle="-|>",
-                mutation_scale=10,
+                mutation_scale=12,
                 shrinkA=0,
                 shrinkB=0,
-                connectionstyle=f"arc3,rad={0.35 if upward else 0.0}",
-                color="0.55",
+                connectionstyle=f"arc3,rad={rad}",
+                color="0.45",
                 lw=1.0,
                 zorder=1,
             )
-            arrow.set_patchA(Circle(tuple(p), r))
-            arrow.set_patchB(Circle(tuple(q), r))
             ax.add_patch(arrow)
             self.arrows[(a, b)] = arrow
         self.nodes = []
         for k, (x, y) in enumerate(layout.pos):
             fill = "white" if pies is not None else IDLE_COLOUR
-            circle = Circle((x, y), r, facecolor=fill, edgecolor="0.3", lw=1.0, zorder=2)
+            idle = pies is not None and pies[k].sum() == 0
+            circle = Circle(
+                (x, y),
+                r,
+                facecolor=fill,
+                edgecolor="0.3",
+                lw=1.0,
+                ls="--" if idle else "-",
+                zorder=2,
+            )
             ax.add_patch(circle)
             self.nodes.append(circle)
             if pies is not None and pies[k].sum() > 0:
@@ -165,6 +174,20 @@ class GraphDrawing:
             arrow.set_color(PATH_COLOUR if live else "0.75")
             arrow.set_linewidth(2.2 if live else 0.8)
         return self.nodes + list(self.arrows.values())
+
+
+def _ends(p: np.ndarray, q: np.ndarray, r: float, rad: float) -> tuple[tuple, tuple]:
+    """Where an edge from node ``p`` to node ``q`` (radius ``r``) leaves and enters them.
+
+    ``rad`` is the arc's curvature (matplotlib's ``arc3``): the arc leaves ``p`` turned by
+    about ``atan(2 * rad)`` from the straight line, and enters ``q`` turned the other way.
+    """
+    d = q - p
+    angle = np.arctan2(d[1], d[0])
+    turn = np.arctan(2 * rad)
+    start = p + r * np.array([np.cos(angle - turn), np.sin(angle - turn)])
+    end = q - r * np.array([np.cos(angle + turn), np.sin(angle + turn)])
+    return tuple(start), tuple(end)
 
 
 def render_svg(dot_path: str | Path) -> Path | None:

@@ -73,8 +73,8 @@ def register_access(replays: dict[str, Replay]) -> dict[str, np.ndarray]:
 
     Accesses are counted per step of each task (so a register of the root, used at every
     step, gets equal shares whatever the episode lengths), then normalised over tasks.
-    Registers never accessed are left out; the rest are ordered by their dominant task,
-    then by how strongly it dominates, so registers shared evenly come last (right).
+    Registers never accessed are left out; the rest are ordered from the most specialised
+    (largest share of one task) to the most evenly shared, ties by their dominant task.
 
     Returns:
         ``tasks`` (K,), ``bank`` and ``register`` (R,) of each register, ``labels`` (R,)
@@ -94,10 +94,8 @@ def register_access(replays: dict[str, Replay]) -> dict[str, np.ndarray]:
     used = np.flatnonzero(count.sum(axis=1) > 0)
     rate = count[used] / steps
     share = rate / rate.sum(axis=1, keepdims=True) if len(used) else rate
-    top = share.max(axis=1)
-    order = np.lexsort((-top, share.argmax(axis=1)))
-    even = top[order] < 1.0 / max(len(tasks), 1) + 0.05
-    order = order[np.argsort(even, kind="stable")]
+    top = np.round(share.max(axis=1), 9)
+    order = np.lexsort((share.argmax(axis=1), -top))  # most specialised first, even last
     used = used[order]
     bank, reg = used // m + 1, used % m
     return {

@@ -8,6 +8,7 @@ program, which the ``video`` extra installs (``pip install "mtpg[video]"``).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from mtpg.analysis.figures6 import pyplot
@@ -75,6 +76,8 @@ def write_video(
     plt = pyplot()
     sl = replay.episode_slice(episode)
     steps = range(sl.start, sl.stop if max_frames is None else min(sl.stop, sl.start + max_frames))
+    # frames are drawn off-screen: no display is needed (and SDL stays quiet without one)
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
     renderer = make_renderer(int(replay["task_id"]))
     task = replay.task
     fig, (ax_task, ax_graph) = plt.subplots(

@@ -109,6 +109,13 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
     axes[0].set_ylim(0, max(2, series["teams"].max(initial=1)) + 0.5)
     axes[1].step(steps, series["instructions"], where="mid", color=colour, lw=1.2)
     axes[1].set_ylabel("instructions\nexecuted")
+    window = len(steps) // 40
+    if window >= 3:  # long episodes: the per-step curve becomes a band; add its running mean
+        kernel = np.ones(window) / window
+        for ax, key in ((axes[0], "teams"), (axes[1], "instructions")):
+            mean = np.convolve(series[key], kernel, mode="valid")
+            ax.plot(steps[window - 1 :], mean, color="black", lw=1.0, label=f"mean of {window}")
+            ax.legend(fontsize=7, loc="lower left")
     has = ~np.isnan(series["oldest"])
     if has.any():
         axes[2].vlines(
@@ -160,9 +167,8 @@ def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path
         sharey=True,
     )
     all_actions = np.concatenate([t["action"][t["final"]] for t in teams] + [np.zeros(0)])
-    lo, hi = (all_actions.min(), all_actions.max()) if len(all_actions) else (-1.0, 1.0)
-    if hi == lo:
-        lo, hi = lo - 1, hi + 1
+    top = float(np.abs(all_actions).max()) if len(all_actions) else 1.0
+    lo, hi = -(top or 1.0), top or 1.0  # symmetric: no torque is the neutral colour
     mappable = None
     for ax, number, team in zip(axes.flat, numbers, teams, strict=False):
         passed = ~team["final"]

@@ -23,13 +23,18 @@ from mtpg.analysis.inside import (
     velocity_prediction,
     visit_statistics,
 )
-from mtpg.analysis.replay import replay_tasks
+from mtpg.analysis.replay import replay_task, replay_tasks
 from mtpg.model.graph import Population
 
 
 def default_decompose_task(tasks: list[str]) -> str:
     """Pendulum when analysed (the paper's Fig. 12a), else the first task."""
     return "Pendulum" if "Pendulum" in tasks else tasks[0]
+
+
+def median_episode(returns: np.ndarray) -> int:
+    """Index of the episode of median return (the lower middle one for an even count)."""
+    return int(np.argsort(returns, kind="stable")[(len(returns) - 1) // 2])
 
 
 def _img(path: Path, title: str) -> str:
@@ -78,7 +83,7 @@ def build_analysis(
         tasks: Task names to replay.
         out: Output directory (created).
         episodes: Test episodes per task (visit shares, register shares, decomposition);
-            the time series use the first episode.
+            the time series replay the episode of median return again, recording memory.
         seed: Test seed offset (the episodes ``mtpg evaluate`` uses with this offset).
         no_memory: Replay with memory off.
         decompose_task: Task of the decomposition figure (default
@@ -97,7 +102,7 @@ def build_analysis(
     index = index_graph(pop, root)
     n_teams = len(index.teams)
     layout = layout_graph(pop, root)
-    replays = replay_tasks(pop, root, tasks, episodes, seed, no_memory, memory_episodes=1)
+    replays = replay_tasks(pop, root, tasks, episodes, seed, no_memory, memory_episodes=0)
     visits = visit_statistics(replays, n_teams)
     access = register_access(replays)
     mem = "memory off" if no_memory else "memory on"
@@ -126,16 +131,18 @@ def build_analysis(
         "tasks": {},
     }
     for task in tasks:
-        series = step_series(replays[task], 0)
-        pred = velocity_prediction(replays[task], 0)
+        typical = median_episode(replays[task]["returns"])
+        one = replay_task(pop, root, task, 1, seed + typical, no_memory)
+        series = step_series(one, 0)
+        pred = velocity_prediction(one, 0)
         name = f"timeseries_{task}.png"
         files[name] = figures6.time_series(
             task,
             series,
             pred,
             out / name,
-            f"{task}: one test episode (seed {int(replays[task]['episode_seeds'][0])}), "
-            f"return {replays[task]['returns'][0]:.2f}",
+            f"{task}: the test episode of median return\n(seed {int(one['episode_seeds'][0])}, "
+            f"return {one['returns'][0]:.2f}, {one.n_steps} steps)",
         )
         sections.append(_img(files[name], f"{task}: run-time dynamics (Figs. 10-11)"))
         summary["tasks"][task] = {

@@ -110,7 +110,7 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
     axes[1].step(steps, series["instructions"], where="mid", color=colour, lw=1.2)
     axes[1].set_ylabel("instructions\nexecuted")
     window = len(steps) // 40
-    if window >= 3:  # long episodes: the per-step curve becomes a band; add its running mean
+    if window >= 10:  # long episodes: the per-step curve becomes a band; add its running mean
         kernel = np.ones(window) / window
         for ax, key in ((axes[0], "teams"), (axes[1], "instructions")):
             mean = np.convolve(series[key], kernel, mode="valid")
@@ -161,14 +161,14 @@ def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path
     fig, axes = plt.subplots(
         rows,
         cols,
-        figsize=(3.3 * cols + 2.2, 2.9 * rows + 1.3),
+        figsize=(3.3 * cols + (2.2 if dec["continuous"] else 0.6), 2.9 * rows + 1.3),
         squeeze=False,
         sharex=True,
         sharey=True,
     )
     all_actions = np.concatenate([t["action"][t["final"]] for t in teams] + [np.zeros(0)])
     top = float(np.abs(all_actions).max()) if len(all_actions) else 1.0
-    lo, hi = -(top or 1.0), top or 1.0  # symmetric: no torque is the neutral colour
+    lo, hi = -(top or 1.0), top or 1.0  # symmetric: no force sits mid-scale
     mappable = None
     for ax, number, team in zip(axes.flat, numbers, teams, strict=False):
         passed = ~team["final"]
@@ -211,8 +211,9 @@ def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path
             for a, c in enumerate(ACTION_COLOURS)
         ] + [passed_handle]
     fig.legend(handles=handles, loc="lower center", ncol=4, fontsize=8)
-    bottom = 0.9 / (2.9 * rows + 1.3)
-    fig.tight_layout(rect=(0, bottom, 0.86, 0.95))
+    bottom = 0.45 / (2.9 * rows + 1.3)
+    coloured = dec["continuous"] and mappable is not None
+    fig.tight_layout(rect=(0, bottom, 0.86 if coloured else 1.0, 0.95))
     if dec["continuous"] and mappable is not None:
         cax = fig.add_axes((0.89, 0.2, 0.02, 0.6))
         fig.colorbar(mappable, cax=cax, label="a_c of the step (coloured: final team)")

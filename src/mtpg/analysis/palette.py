@@ -19,7 +19,7 @@ TASK_COLOURS: dict[str, str] = dict(
 #: Colours of the three atomic discrete actions (Fig. 12 style decompositions).
 ACTION_COLOURS: tuple[str, ...] = ("#0072b2", "#e69f00", "#cc79a7")
 #: Colormap of continuous actions.
-CONTINUOUS_CMAP = "coolwarm"
+CONTINUOUS_CMAP = "viridis"  # no grey anywhere: grey marks "passed on"
 #: Points where a team was visited but passed execution on.
 PASSED_COLOUR = "#b0b0b0"
 #: The decision path in graph pictures and videos.

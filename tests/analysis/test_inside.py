@@ -71,6 +71,7 @@ def test_memory_ages_are_exact_when_a_register_is_written_every_k_steps(k):
     obs = np.zeros((n, 2))
     obs[:, 0] = np.where(np.arange(n) % k == 0, 1.0, -1.0)
     rep = replay_observations(pop, root, obs)
+    assert np.array_equal(rep["observation"], obs)  # the trace records what each decision saw
     teams = rep.per_step("visit", "visit_team")
     assert [len(t) for t in teams] == [2 if t % k == 0 else 1 for t in range(n)]
     reads = ~rep["mem_is_write"]

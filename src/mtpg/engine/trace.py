@@ -85,7 +85,7 @@ def trace_kernel(
         ``prog_log (k, 2)`` [step, program], ``bids (k)``, ``instr_log (k, 2)``
         [step, instruction], ``mem_log (k, 5)`` [step, bank, register, is_write,
         last_written_step], ``memory (n, n_banks * M)`` after each step (empty unless
-        ``snapshot``), ``states (n + 1, STATE_SIZE)``.
+        ``snapshot``), ``states (n + 1, STATE_SIZE)``, ``observations (n, 2)``.
     """
     n_teams = len(team_offsets) - 1
     n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
@@ -98,6 +98,7 @@ def trace_kernel(
     actions = np.zeros((max_steps, 2))
     rewards = np.zeros(max_steps)
     states = np.zeros((max_steps + 1, STATE_SIZE))
+    observations = np.zeros((max_steps, 2))
     memory = np.zeros((max_steps if snapshot else 0, n_banks * M))
     team_log = np.empty((64, 2), dtype=np.int64)
     prog_log = np.empty((64, 2), dtype=np.int64)
@@ -114,6 +115,8 @@ def trace_kernel(
         if task < 0:
             obs[0] = obs_seq[t, 0]
             obs[1] = obs_seq[t, 1]
+        observations[t, 0] = obs[0]
+        observations[t, 1] = obs[1]
         visited[:] = False
         team = root
         while True:
@@ -193,6 +196,7 @@ def trace_kernel(
         mem_log[:n_mem],
         memory[:t],
         states[: t + 1],
+        observations[:t],
     )
 
 
@@ -210,6 +214,7 @@ class Trace:
         mem_log: int64 ``(k, 5)``: ``step, bank, register, is_write, last_written_step``.
         memory: float64 ``(n, n_banks * M)``: all banks after each decision (if asked).
         states: float64 ``(n + 1, STATE_SIZE)``: task state before each step and at the end.
+        observations: float64 ``(n, 2)``: the inputs ``s(t)`` each decision saw.
     """
 
     actions: np.ndarray
@@ -221,6 +226,7 @@ class Trace:
     mem_log: np.ndarray
     memory: np.ndarray
     states: np.ndarray
+    observations: np.ndarray
 
     def teams_per_decision(self) -> np.ndarray:
         """Number of teams visited in each decision."""

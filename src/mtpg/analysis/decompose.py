@@ -1,0 +1,62 @@
+"""Task decomposition by team (paper Fig. 12): where in state space each team runs.
+
+For one task's replay, each team gets the points ``(observed variable, hidden velocity)``
+of the steps at which it was visited; a point is *final* when the team chose the action
+at that step (it is then coloured by that action), otherwise the team passed execution
+on (grey). The observed variable is the task's first input ``s[0]``; the velocity is the
+state slot of :data:`mtpg.analysis.inside.HIDDEN_VELOCITY`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mtpg.analysis.inside import HIDDEN_VELOCITY, VELOCITY_NAME
+from mtpg.analysis.replay import Replay
+from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.tasks import ACTION_BOUND, OBSERVED, USES_CONTINUOUS
+
+
+def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
+    """Points of each team in (observed variable, hidden velocity) space.
+
+    Args:
+        replay: One task's replay.
+        n_teams: Teams of the graph.
+
+    Returns:
+        ``teams``: a list over team numbers 1..n_teams of dicts with ``x``, ``y``, ``final``
+        (bool) and ``action`` (the action of the step: for a continuous task ``a_c``
+        clipped to the task's bound, as the task applies it, else ``a_d``) arrays;
+        ``continuous`` (bool), ``x_label``, ``y_label``.
+    """
+    task = replay.task
+    task_id = TASK_NAMES.index(task)
+    continuous = bool(USES_CONTINUOUS[task_id])
+    counts = replay.counts("visit")
+    step_of_visit = np.repeat(np.arange(replay.n_steps), counts)
+    last_visit = np.zeros(len(step_of_visit), dtype=bool)
+    last_visit[replay["visit_offsets"][1:] - 1] = True
+    x = replay["observation"][:, 0]
+    y = replay["hidden_state"][:, HIDDEN_VELOCITY[task]]
+    bound = float(ACTION_BOUND[task_id])
+    action = np.clip(replay["a_c"], -bound, bound) if continuous else replay["a_d"] * 1.0
+    teams = []
+    for number in range(1, n_teams + 1):
+        sel = replay["visit_team"] == number
+        steps = step_of_visit[sel]
+        teams.append(
+            {
+                "x": x[steps],
+                "y": y[steps],
+                "final": last_visit[sel],
+                "action": action[steps],
+            }
+        )
+    return {
+        "task": task,
+        "teams": teams,
+        "continuous": continuous,
+        "x_label": f"observed s[0] = {OBSERVED[task_id].split(',')[0]}",
+        "y_label": f"hidden {VELOCITY_NAME[task]}",
+    }

@@ -1,0 +1,216 @@
+"""A program graph as a researcher reads it: stable numbers, a text listing and GraphViz DOT.
+
+Teams are numbered 1, 2, ... in the depth-first order of
+:meth:`mtpg.model.graph.Population.reachable` from the root (the root is team 1), and
+memory banks 1, 2, ... in order of first use by the programs of those teams. The
+numbers depend on the graph alone, so every figure, listing and replay file of the same
+graph agrees on them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mtpg.model.graph import Population
+from mtpg.model.instructions import disassemble, effective_mask
+
+
+@dataclass(frozen=True)
+class GraphIndex:
+    """Stable numbering of the teams, programs and banks of one graph.
+
+    Attributes:
+        root: Model id of the root team.
+        teams: Model team ids in numbering order (``teams[0]`` is the root, number 1).
+        programs: Model program ids in order of first use.
+        banks: Model bank ids in order of first use.
+    """
+
+    root: int
+    teams: tuple[int, ...]
+    programs: tuple[int, ...]
+    banks: tuple[int, ...]
+
+    def team_number(self, team_id: int) -> int:
+        """The 1-based number of a model team id."""
+        return self.teams.index(team_id) + 1
+
+    def bank_number(self, bank_id: int) -> int:
+        """The 1-based number of a model bank id."""
+        return self.banks.index(bank_id) + 1
+
+    def edges(self, pop: Population) -> list[tuple[int, int, int]]:
+        """``(from team, to team, program)`` model ids of every pointer between teams."""
+        out = []
+        for tid in self.teams:
+            for pid in pop.teams[tid].programs:
+                target = pop.programs[pid].action
+                if target >= 0:
+                    out.append((tid, target, pid))
+        return out
+
+    def depths(self, pop: Population) -> dict[int, int]:
+        """Shortest number of edges from the root to each team (breadth-first)."""
+        depth = {self.root: 0}
+        frontier = [self.root]
+        while frontier:
+            nxt = []
+            for tid in frontier:
+                for pid in pop.teams[tid].programs:
+                    target = pop.programs[pid].action
+                    if target >= 0 and target not in depth:
+                        depth[target] = depth[tid] + 1
+                        nxt.append(target)
+            frontier = nxt
+        return depth
+
+
+def index_graph(pop: Population, root: int) -> GraphIndex:
+    """Numbers the teams, programs and banks reachable from ``root``.
+
+    Raises:
+        ValueError: When ``root`` is not a team of ``pop``.
+    """
+    if root not in pop.teams:
+        raise ValueError(f"root team {root} is not in the population")
+    teams = pop.reachable(root)
+    programs = list(dict.fromkeys(pid for tid in teams for pid in pop.teams[tid].programs))
+    banks = list(dict.fromkeys(pop.programs[pid].bank for pid in programs))
+    return GraphIndex(root, tuple(teams), tuple(programs), tuple(banks))
+
+
+def _action_text(pop: Population, index: GraphIndex, pid: int) -> str:
+    prog = pop.programs[pid]
+    if prog.is_atomic:
+        return f"action {prog.atomic_action}"
+    return f"-> team {index.team_number(prog.action)}"
+
+
+def describe_graph(pop: Population, root: int, meta: dict | None = None) -> str:
+    """The text listing of ``mtpg show``.
+
+    Lists every team with its programs in execution order; each program with its action
+    pointer, its memory bank and its instructions disassembled, introns (instructions
+    that affect neither the bid ``r[0]`` nor memory; the compiler drops them) marked
+    ``intron``; then the memory banks shared by more than one program.
+
+    Args:
+        pop: The population holding the graph.
+        root: Root team id.
+        meta: The graph file's metadata (printed when given).
+
+    Returns:
+        The listing, lines joined by newlines.
+    """
+    index = index_graph(pop, root)
+    layout = pop.layout
+    n_instr = sum(len(pop.programs[p].instructions) for p in index.programs)
+    n_eff = sum(
+        int(effective_mask(pop.programs[p].instructions, layout).sum()) for p in index.programs
+    )
+    lines = [
+        f"graph: {len(index.teams)} team(s), {len(index.programs)} programs, "
+        f"{len(index.banks)} memory banks of {layout.n_memory} registers, "
+        f"{n_instr} instructions ({n_eff} effective, {n_instr - n_eff} introns)",
+        "numbers: team N is the N-th team in depth-first order from the root (team 1); "
+        "bank N likewise by first use",
+    ]
+    for key, value in sorted((meta or {}).items()):
+        if isinstance(value, str | int | float | bool):
+            lines.append(f"meta {key}: {value}")
+    depth = index.depths(pop)
+    for tid in index.teams:
+        team = pop.teams[tid]
+        lines.append("")
+        lines.append(
+            f"team {index.team_number(tid)} (id {tid}, depth {depth[tid]}, born generation "
+            f"{team.birth}): {len(team.programs)} programs"
+        )
+        for k, pid in enumerate(team.programs):
+            prog = pop.programs[pid]
+            mask = effective_mask(prog.instructions, layout)
+            lines.append(
+                f"  program {k + 1} (id {pid}) {_action_text(pop, index, pid)}, "
+                f"bank {index.bank_number(prog.bank)}, {len(mask)} instructions "
+                f"({int(mask.sum())} effective)"
+            )
+            for j, (text, live) in enumerate(
+                zip(disassemble(prog.instructions, layout), mask, strict=True)
+            ):
+                lines.append(f"    {j:3d}  {text:<34}{'' if live else '  intron'}".rstrip())
+    users = bank_users(pop, index)
+    shared = {b: u for b, u in users.items() if len(u) > 1}
+    lines.append("")
+    lines.append(f"memory banks shared by more than one program: {len(shared)} of {len(users)}")
+    for bank, progs in shared.items():
+        where = ", ".join(f"team {t} program {k}" for t, k in progs)
+        lines.append(f"  bank {bank}: {where}")
+    return "\n".join(lines)
+
+
+def bank_users(pop: Population, index: GraphIndex) -> dict[int, list[tuple[int, int]]]:
+    """Bank number -> ``(team number, program position 1..)`` of every program using it."""
+    users: dict[int, list[tuple[int, int]]] = {k + 1: [] for k in range(len(index.banks))}
+    for tid in index.teams:
+        for k, pid in enumerate(pop.teams[tid].programs):
+            bank = index.bank_number(pop.programs[pid].bank)
+            users[bank].append((index.team_number(tid), k + 1))
+    return users
+
+
+def graph_dot(
+    pop: Population, root: int, highlight: list[int] | None = None, title: str | None = None
+) -> str:
+    """GraphViz DOT of the team graph: one node per team, one edge per team pointer.
+
+    Each node lists its atomic actions; edges are labelled with the pointing program's
+    position in its team. ``highlight`` (model team ids, a decision path) is drawn green.
+    """
+    index = index_graph(pop, root)
+    on_path = set(highlight or [])
+    path_edges = set(zip(highlight or [], (highlight or [])[1:], strict=False))
+    lines = ["digraph tpg {", "  rankdir=TB;", '  node [shape=ellipse, fontname="Helvetica"];']
+    if title:
+        lines.append(f'  label="{title}"; labelloc=t;')
+    for tid in index.teams:
+        num = index.team_number(tid)
+        progs = [pop.programs[p] for p in pop.teams[tid].programs]
+        acts = sorted({p.atomic_action for p in progs if p.is_atomic})
+        label = f"{num}\\nactions {','.join(map(str, acts))}"
+        style = ', style=filled, fillcolor="#a1d99b"' if tid in on_path else ""
+        shape = ", shape=doublecircle" if tid == root else ""
+        lines.append(f'  t{num} [label="{label}"{shape}{style}];')
+    for src, dst, pid in index.edges(pop):
+        pos = pop.teams[src].programs.index(pid) + 1
+        colour = ', color="#2ca02c", penwidth=2.5' if (src, dst) in path_edges else ""
+        lines.append(
+            f'  t{index.team_number(src)} -> t{index.team_number(dst)} [label="p{pos}"{colour}];'
+        )
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def effective_instruction_map(pop: Population, program_ids: np.ndarray) -> tuple[np.ndarray, ...]:
+    """For compiled instruction rows: the model program id and index of each instruction.
+
+    The compiler keeps only effective instructions, in program order; this maps the
+    compiled rows back to ``(program id, position in the program's full code)``.
+
+    Args:
+        pop: The population.
+        program_ids: Model program ids in compiled (dense) order.
+
+    Returns:
+        ``(program, position)`` int64 arrays over all compiled instruction rows.
+    """
+    progs, positions = [], []
+    for pid in program_ids:
+        prog = pop.programs[int(pid)]
+        where = np.flatnonzero(effective_mask(prog.instructions, pop.layout))
+        progs.append(np.full(len(where), int(pid), dtype=np.int64))
+        positions.append(where.astype(np.int64))
+    if not progs:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return np.concatenate(progs), np.concatenate(positions)

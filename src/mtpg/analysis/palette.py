@@ -1,0 +1,39 @@
+"""The colours of the section-6 figures, in one place so every figure agrees.
+
+Each task keeps one colour in every figure (graph pies, register bars, time series,
+videos); the section-5 figures of :mod:`mtpg.analysis.plots` colour runs, not tasks.
+"""
+
+from __future__ import annotations
+
+from mtpg.envs.core import TASK_NAMES
+
+#: One colour per task, in task-id order (matplotlib's colour-blind-safe "tab10" picks).
+TASK_COLOURS: dict[str, str] = dict(
+    zip(
+        TASK_NAMES,
+        ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"),
+        strict=True,
+    )
+)
+#: Colours of the three atomic discrete actions (Fig. 12 style decompositions).
+ACTION_COLOURS: tuple[str, ...] = ("#0072b2", "#e69f00", "#cc79a7")
+#: Colormap of continuous actions.
+CONTINUOUS_CMAP = "viridis"  # no grey anywhere: grey marks "passed on"
+#: Points where a team was visited but passed execution on.
+PASSED_COLOUR = "#b0b0b0"
+#: The decision path in graph pictures and videos.
+PATH_COLOUR = "#2ca02c"
+#: Teams and edges off the path.
+IDLE_COLOUR = "#d9d9d9"
+
+
+def task_colour(task: str) -> str:
+    """The colour of a task name.
+
+    Raises:
+        ValueError: For an unknown task.
+    """
+    if task not in TASK_COLOURS:
+        raise ValueError(f"unknown task {task!r}; choose from {', '.join(TASK_NAMES)}")
+    return TASK_COLOURS[task]

@@ -298,7 +298,8 @@ def graph_from_dict(d: Any) -> tuple[Population, int]:
     """Rebuilds a population holding one graph from :func:`graph_to_dict` output.
 
     Ids are kept; the counters are set one past the largest team, program and bank id.
-    The population's banks are the banks the graph's programs point to. ``code`` lines are ignored (``instructions`` are authoritative).
+    The population's banks are the banks the graph's programs point to. ``code`` lines
+    are ignored (``instructions`` are authoritative).
 
     Args:
         d: The dict (as read from JSON).

@@ -184,3 +184,21 @@ def test_paper_preset_is_the_published_run():
     assert cfg.evaluation.n_subsets * cfg.elites_per_subset == 1575  # new roots per generation
     table3 = build_config("paper", overrides=["team.n_elite=50"])
     assert table3.evaluation.n_subsets * table3.elites_per_subset == 3150
+
+
+@pytest.mark.parametrize(
+    ("banks", "needle"),
+    [
+        ([0, 1, 2], "program 3 points to missing bank 3"),
+        ([0, 1, 2, 3, 3], "population.banks repeats a bank"),
+        ([0, 1, 2, 3, 99], "bank id 99 outside counter"),
+        ([0, 1, "2", 3], "population.banks[2] must be an integer"),
+    ],
+)
+def test_population_loader_checks_the_bank_list(banks, needle):
+    from mtpg.io.serialize import FormatError
+
+    d = population_to_dict(two_team_population())
+    d["banks"] = banks
+    with pytest.raises(FormatError, match=needle.replace("[", r"\[").replace("]", r"\]")):
+        population_from_dict(d)

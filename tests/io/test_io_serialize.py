@@ -79,7 +79,7 @@ def corrupt(d, edit):
 
 POP_ERRORS = [
     (lambda d: d.update(format="mtpg-graph"), "format"),
-    (lambda d: d.update(version=2), "unsupported version 2"),
+    (lambda d: d.update(version=3), "unsupported version 3"),
     (lambda d: d.pop("next_team_id"), "missing key 'next_team_id'"),
     (lambda d: d["layout"].update(n_memory=0), "layout.n_memory"),
     (lambda d: d["programs"][0].update(id="3"), "must be an integer"),

@@ -1,9 +1,9 @@
 import numpy as np
 
+from mtpg.engine.compile import effective_mask
 from mtpg.model.instructions import (
     RegisterLayout,
     disassemble,
-    effective_mask,
     random_instructions,
     valid_instructions,
 )
@@ -57,3 +57,12 @@ def test_effective_mask_liveness_chain():
         dtype=np.int32,
     )
     assert effective_mask(code, L).tolist() == [True, False, True, False]
+
+
+def test_model_imports_no_numba():
+    import subprocess
+    import sys
+
+    code = "import sys, mtpg.model, mtpg.model.graph; print('numba' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

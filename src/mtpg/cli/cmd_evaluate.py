@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from mtpg.cli.memory_option import add_memory_option, resolve_no_memory
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Adds the ``evaluate`` command."""
@@ -14,7 +16,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="test a program graph on unseen episodes",
         description="Score a graph file, or the champion of all tasks of a run directory, on "
         "test episodes (seeds disjoint from training), raw and normalised against random "
-        "play (0) and the reference best (1).",
+        "play (0) and the reference best (1). A graph runs with memory as it was evolved "
+        "(a TPG-NoMemory graph without memory) unless --memory says otherwise.",
     )
     p.add_argument("target", metavar="GRAPH_OR_RUN", help="a graph .json file or a run directory")
     p.add_argument("--tasks", help="comma-separated tasks (default: the graph's or run's tasks)")
@@ -22,6 +25,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="test seed offset (default 0)")
     p.add_argument("--workers", type=int, default=1, help="threads (default 1)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead")
+    add_memory_option(p)
     p.set_defaults(func=run)
 
 
@@ -36,11 +40,13 @@ def resolve_graph(target: Path):
     from mtpg.io.serialize import load_graph
 
     if target.is_dir():
-        tasks = list(read_run_config(target).evaluation.tasks)
+        evaluation = read_run_config(target).evaluation
+        tasks = list(evaluation.tasks)
         path = RunDir(target).champions / champion_filename(tuple(tasks))
         if not path.is_file():
             raise FileNotFoundError(f"{path}: the run has no champion yet")
         pop, root, meta = load_graph(path)
+        meta.setdefault("no_memory", evaluation.no_memory)  # champions of older runs
         return pop, root, meta, tasks
     pop, root, meta = load_graph(target)
     from mtpg.envs.core import TASK_NAMES
@@ -63,9 +69,10 @@ def run(args: argparse.Namespace) -> int:
     unknown = [t for t in tasks if t not in TASK_NAMES]
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
-    scores = evaluate_graph(pop, root, tasks, args.episodes, args.seed, args.workers)
+    no_memory, memory = resolve_no_memory(args.memory, meta)
+    scores = evaluate_graph(pop, root, tasks, args.episodes, args.seed, args.workers, no_memory)
     single = single_task_bests(Path(args.target), tasks)
-    out = {t: s.as_dict() for t, s in scores.items()}
+    out = {t: {**s.as_dict(), "no_memory": no_memory, "memory": memory} for t, s in scores.items()}
     for t, best in single.items():
         out[t]["best_single_task"] = best
         out[t]["normalised_single_task"] = normalise_scores({t: scores[t].mean}, {t: best})[t]
@@ -78,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(
         f"{args.target}: root team {root}, {len(pop.reachable(root))} teams; "
-        f"{args.episodes} test episodes per task (seed offset {args.seed})"
+        f"{args.episodes} test episodes per task (seed offset {args.seed}); {memory}"
     )
     print(
         "normalised: 0 = random play, 1 = reference best"

@@ -11,7 +11,10 @@ The kernels work on one float64 *workspace* per thread:
 
 Instruction operands are rewritten from the logical layout of
 :mod:`mtpg.model.instructions` to absolute workspace indices, so a program touches its
-memory bank in place with no copying. Introns are dropped here.
+memory bank in place with no copying. Introns are dropped here (:func:`effective_mask`).
+
+Only banks some program points to are compiled: a bank of the population that no program
+uses (a fresh bank) can never be read or written, so it needs no workspace.
 """
 
 from __future__ import annotations
@@ -19,9 +22,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from mtpg.model.graph import Population, Program
-from mtpg.model.instructions import N_CONSTANTS, RegisterLayout, effective_mask
+from mtpg.model.instructions import (
+    N_CONSTANTS,
+    OP_COS,
+    OP_CUBE,
+    OP_IF_LT,
+    RegisterLayout,
+)
 
 
 @dataclass(frozen=True)
@@ -89,6 +99,49 @@ class CompiledPopulation:
             self.layout.n_memory,
             self.mem_base,
         )
+
+
+@njit(cache=True, error_model="numpy")
+def _effective_kernel(code: np.ndarray, n_r: int) -> np.ndarray:
+    """Backward liveness pass of :func:`effective_mask` over ``code`` (logical operands)."""
+    live = np.zeros(n_r, dtype=np.bool_)
+    live[0] = True
+    mask = np.zeros(len(code), dtype=np.bool_)
+    for k in range(len(code) - 1, -1, -1):
+        op, dst, a, b = code[k, 0], code[k, 1], code[k, 2], code[k, 3]
+        cond = op >= OP_IF_LT
+        if dst < n_r:
+            if not live[dst]:
+                continue
+            if not cond:
+                live[dst] = False
+        mask[k] = True
+        if b < n_r:
+            live[b] = True
+        if a < n_r and not (OP_COS <= op <= OP_CUBE):
+            live[a] = True
+        if cond and dst < n_r:
+            live[dst] = True
+    return mask
+
+
+def effective_mask(instructions: np.ndarray, layout: RegisterLayout) -> np.ndarray:
+    """Marks the instructions that can affect ``r[0]`` or any memory register.
+
+    A backward liveness pass: the live set starts as ``{r[0]}``; every write to memory is
+    effective (memory is stateful and shared); a write to ``r[i]`` is effective only when
+    ``r[i]`` is live. An effective unconditional write kills its target, then its
+    operands become live (unary operations read only the second operand; a conditional
+    also reads its target).
+
+    Args:
+        instructions: int array ``(n, 4)``.
+        layout: Register sizes.
+
+    Returns:
+        Boolean array of length ``n``; False marks an intron.
+    """
+    return _effective_kernel(np.ascontiguousarray(instructions, dtype=np.int32), layout.n_registers)
 
 
 def workspace_map(layout: RegisterLayout, bank: int, mem_base: int) -> np.ndarray:

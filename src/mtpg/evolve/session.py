@@ -132,6 +132,7 @@ class Session:
                     "seed": self.config.seed,
                     "test": {t: row[f"test_{t}"] for t in self.config.evaluation.tasks},
                     "test_episodes": self.config.evaluation.test_episodes,
+                    "no_memory": self.config.evaluation.no_memory,
                 }
                 keep[names] = (state.population, int(row["root"]), meta)
         folder = self.run.path / TESTS_DIR / f"gen-{state.generation:06d}"
@@ -153,6 +154,7 @@ class Session:
                 "train_scores": {
                     t: float(scores[self.config.evaluation.tasks.index(t)]) for t in names
                 },
+                "no_memory": self.config.evaluation.no_memory,
             }
             champions[names] = (state.population, root, meta)
         write_champions(self.run.path, champions)

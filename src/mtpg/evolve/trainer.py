@@ -55,6 +55,8 @@ def metric_columns(tasks: tuple[str, ...]) -> list[str]:
         "teams",
         "programs",
         "banks",
+        "banks_in_use",
+        "programs_per_bank",
         "new_roots",
         "decisions",
         "teams_per_decision",
@@ -129,7 +131,8 @@ class Trainer:
         elites and one drawn from all roots. Then every new root is evaluated on the
         training episodes of each task, every subset chooses its elites, and every other
         root is deleted, followed by internal teams no longer referenced, programs no
-        team holds and (implicitly) banks no program uses.
+        team holds and banks no program points to; then fresh banks are added until there
+        are at least as many banks as teams.
         """
         st, cfg = self.state, self.config
         gen = st.generation + 1
@@ -228,18 +231,22 @@ class Trainer:
                 break
             for t in orphans:
                 del pop.teams[t]
-        pop.prune()
+        pop.prune()  # programs no team holds, then banks no program points to
+        pop.top_up_banks(len(pop.teams))  # the bank population: at least one bank per team
 
     def _metrics(self, new_roots, result, times) -> dict[str, float]:
         st, pop = self.state, self.state.population
         decisions = int(result.steps.sum())
+        in_use = pop.banks_in_use()
         scores = np.array([st.scores[r] for r in sorted(st.scores)])
         row: dict[str, float] = {
             "generation": st.generation,
             "roots": len(st.scores),
             "teams": len(pop.teams),
             "programs": len(pop.programs),
-            "banks": len(pop.banks()),
+            "banks": len(pop.memory_banks),
+            "banks_in_use": len(in_use),
+            "programs_per_bank": len(pop.programs) / max(len(in_use), 1),
             "new_roots": len(new_roots),
             "decisions": decisions,
             "teams_per_decision": result.teams.sum() / max(decisions, 1),

@@ -7,6 +7,8 @@ its behaviour.
 
 from __future__ import annotations
 
+from bisect import bisect_left
+
 import numpy as np
 
 from mtpg.config import ProgramConfig, RunConfig, TeamConfig
@@ -84,7 +86,7 @@ class Varier:
         self.roots = set(pop.roots())
         self.targets = [tid for tid, t in pop.teams.items() if t.birth < generation]
         self.program_pool = list(pop.programs)
-        self.banks = sorted(pop.banks())
+        self.banks = pop.banks()  # the whole bank population, ascending, fresh banks included
 
     def child(self, parent1: int, parent2: int) -> int:
         """Creates one new root team from two parents and returns its id."""
@@ -161,9 +163,20 @@ class Varier:
             last_atomic = action < 0 and sum(self._is_atomic(q) for q in progs) == 1
             action = self._new_action(action, force_atomic=last_atomic)
         if rng.random() < self.cfg.p_memory and len(self.banks) > 1:
-            choice = self.banks[int(rng.integers(0, len(self.banks) - 1))]
-            bank = choice if choice != old.bank else self.banks[-1]
+            bank = self._other_bank(old.bank)
         return self.pop.add_program(code, action, bank).id
+
+    def _other_bank(self, current: int) -> int:
+        """Draws a bank uniformly from the bank population except ``current``.
+
+        Every bank counts, including fresh ones no program points to yet (added by the
+        top-up after selection), so a program can gain memory of its own.
+        """
+        k = bisect_left(self.banks, current)
+        if k < len(self.banks) and self.banks[k] == current:
+            i = int(self.rng.integers(0, len(self.banks) - 1))
+            return self.banks[i + (i >= k)]
+        return self.banks[int(self.rng.integers(0, len(self.banks)))]
 
     def _new_action(self, current: int, force_atomic: bool) -> int:
         """Draws a new action pointer: atomic with ``p_atomic``, else an older team.

@@ -24,12 +24,23 @@ import numpy as np
 
 from mtpg.io._atomic import atomic_write_bytes
 from mtpg.io._readable import dumps_readable
-from mtpg.model.graph import N_ACTIONS, Population, Program, Team, atomic, check_invariants
+from mtpg.model.graph import (
+    N_ACTIONS,
+    InvariantError,
+    Population,
+    Program,
+    Team,
+    atomic,
+    check_invariants,
+)
 from mtpg.model.instructions import RegisterLayout, disassemble, valid_instructions
 
 #: Format tag and version of a population dict.
 POPULATION_FORMAT = "mtpg-population"
-POPULATION_VERSION = 1
+POPULATION_VERSION = 2
+#: Population versions this mtpg reads. Version 1 had no bank list: its banks are the
+#: banks its programs point to (a version-1 population had no others).
+POPULATION_VERSIONS = (1, 2)
 #: Format tag and version of a graph file.
 GRAPH_FORMAT = "mtpg-graph"
 GRAPH_VERSION = 1
@@ -70,13 +81,15 @@ def _list(value: Any, where: str) -> list[Any]:
     return value
 
 
-def _check_tag(d: dict[str, Any], fmt: str, version: int, what: str) -> None:
+def _check_tag(d: dict[str, Any], fmt: str, versions: tuple[int, ...], what: str) -> int:
     tag = _key(d, "format", what)
     if tag != fmt:
         raise FormatError(f"{what}: format is {tag!r}, expected {fmt!r}")
     found = _key(d, "version", what)
-    if found != version or isinstance(found, bool):
-        raise FormatError(f"{what}: unsupported version {found!r} (this mtpg reads {version})")
+    if found not in versions or isinstance(found, bool):
+        readable = " or ".join(str(v) for v in versions)
+        raise FormatError(f"{what}: unsupported version {found!r} (this mtpg reads {readable})")
+    return found
 
 
 def _layout_from(value: Any) -> RegisterLayout:
@@ -109,7 +122,7 @@ def _instructions_from(value: Any, where: str, layout: RegisterLayout) -> np.nda
 def _check_population(pop: Population, what: str) -> None:
     try:
         check_invariants(pop)
-    except AssertionError as exc:
+    except InvariantError as exc:
         raise FormatError(f"{what}: {exc}") from exc
 
 
@@ -132,6 +145,7 @@ def population_to_dict(pop: Population) -> dict[str, Any]:
 
     Returns:
         A JSON-native dict: ``format``, ``version``, ``layout``, the three id counters,
+        ``banks`` (the bank population, ascending, banks no program points to included),
         ``programs`` (``id``, ``action``, ``bank``, ``instructions``) and ``teams``
         (``id``, ``programs``, ``birth``), both lists in the population's dict order.
     """
@@ -142,6 +156,7 @@ def population_to_dict(pop: Population) -> dict[str, Any]:
         "next_program_id": int(pop.next_program_id),
         "next_team_id": int(pop.next_team_id),
         "next_bank_id": int(pop.next_bank_id),
+        "banks": [int(b) for b in pop.banks()],
         "programs": [
             {
                 "id": int(p.id),
@@ -175,7 +190,7 @@ def population_from_dict(d: Any) -> Population:
         FormatError: Naming the first problem found.
     """
     d = _object(d, "population")
-    _check_tag(d, POPULATION_FORMAT, POPULATION_VERSION, "population")
+    version = _check_tag(d, POPULATION_FORMAT, POPULATION_VERSIONS, "population")
     pop = Population(layout=_layout_from(_key(d, "layout", "population")))
     for name in ("next_program_id", "next_team_id", "next_bank_id"):
         setattr(pop, name, _int(_key(d, name, "population"), f"population.{name}", lo=0))
@@ -200,6 +215,13 @@ def population_from_dict(d: Any) -> Population:
         members = _ids_list(_key(obj, "programs", where), f"{where} programs")
         birth = _int(_key(obj, "birth", where), f"{where} birth")
         pop.teams[tid] = Team(tid, members, birth)
+    if version == 1:
+        pop.memory_banks = pop.banks_in_use()
+    else:
+        banks = _ids_list(_key(d, "banks", "population"), "population.banks")
+        pop.memory_banks = set(banks)
+        if len(pop.memory_banks) != len(banks):
+            raise FormatError("population.banks repeats a bank")
     _check_population(pop, "population")
     return pop
 
@@ -276,7 +298,8 @@ def graph_from_dict(d: Any) -> tuple[Population, int]:
     """Rebuilds a population holding one graph from :func:`graph_to_dict` output.
 
     Ids are kept; the counters are set one past the largest team, program and bank id.
-    ``code`` lines are ignored (``instructions`` are authoritative).
+    The population's banks are the banks the graph's programs point to. ``code`` lines
+    are ignored (``instructions`` are authoritative).
 
     Args:
         d: The dict (as read from JSON).
@@ -289,7 +312,7 @@ def graph_from_dict(d: Any) -> tuple[Population, int]:
             pointer, bad instruction ...).
     """
     d = _object(d, "graph")
-    _check_tag(d, GRAPH_FORMAT, GRAPH_VERSION, "graph")
+    _check_tag(d, GRAPH_FORMAT, (GRAPH_VERSION,), "graph")
     for key in ("root", "layout", "meta", "teams", "programs"):
         _key(d, key, "graph")
     _object(d["meta"], "graph meta")
@@ -326,7 +349,8 @@ def graph_from_dict(d: Any) -> tuple[Population, int]:
         raise FormatError(f"graph root {root} is not one of its teams")
     pop.next_team_id = max(pop.teams) + 1
     pop.next_program_id = max(pop.programs, default=-1) + 1
-    pop.next_bank_id = max((p.bank for p in pop.programs.values()), default=-1) + 1
+    pop.memory_banks = pop.banks_in_use()  # a graph's banks are those its programs use
+    pop.next_bank_id = max(pop.memory_banks, default=-1) + 1
     _check_population(pop, "graph")
     return pop, root
 

@@ -1,6 +1,10 @@
-"""The representation: linear register programs, teams, memory banks and program graphs."""
+"""The representation: linear register programs, teams, memory banks and program graphs.
 
-from mtpg.model.graph import Population, Program, Team, check_invariants
+Plain Python and NumPy only: compiled code (Numba) lives in :mod:`mtpg.engine`, including
+the effective-instruction analysis (:func:`mtpg.engine.compile.effective_mask`).
+"""
+
+from mtpg.model.graph import InvariantError, Population, Program, Team, check_invariants
 from mtpg.model.instructions import (
     CONSTANTS,
     N_CONSTANTS,
@@ -8,12 +12,12 @@ from mtpg.model.instructions import (
     OP_NAMES,
     RegisterLayout,
     disassemble,
-    effective_mask,
     random_instructions,
 )
 
 __all__ = [
     "CONSTANTS",
+    "InvariantError",
     "N_CONSTANTS",
     "N_OPS",
     "OP_NAMES",
@@ -23,6 +27,5 @@ __all__ = [
     "Team",
     "check_invariants",
     "disassemble",
-    "effective_mask",
     "random_instructions",
 ]

@@ -5,8 +5,14 @@ discrete action in {0, 1, 2} or another team) and its shared memory *bank*. A
 :class:`Team` is an ordered list of program ids; several teams may hold the same program.
 An edge runs from a team to every team its programs point to; cycles are allowed (the
 engine never visits a team twice in one decision). Teams with in-degree 0 are *roots*:
-the agents that evolution selects, deletes and varies. Memory banks are plain integer ids:
-their contents exist only while an episode runs.
+the agents that evolution selects, deletes and varies.
+
+Memory banks are a population of their own (paper section 4.1: "teams, programs, and
+shared memory registers are each stored in separate populations and coevolved"): the
+population holds the set of bank ids, a bank may exist with no program pointing to it
+(a fresh bank, ready for a memory-pointer mutation), and evolution deletes banks no
+program points to and tops the set up with fresh ones (:meth:`Population.prune`,
+:meth:`Population.top_up_banks`). A bank's contents exist only while an episode runs.
 """
 
 from __future__ import annotations
@@ -19,6 +25,10 @@ from mtpg.model.instructions import RegisterLayout, valid_instructions
 
 #: Number of atomic discrete actions.
 N_ACTIONS = 3
+
+
+class InvariantError(ValueError):
+    """A population breaks one of its structural rules; the message names the rule."""
 
 
 def atomic(action: int) -> int:
@@ -81,6 +91,8 @@ class Population:
         layout: Register sizes shared by all programs.
         programs: Programs by id.
         teams: Teams by id (insertion order is creation order).
+        memory_banks: Ids of the memory banks (the bank population); every program's
+            bank is one of them, and some may have no program pointing to them.
         next_program_id: Next fresh program id.
         next_team_id: Next fresh team id.
         next_bank_id: Next fresh memory bank id.
@@ -89,19 +101,32 @@ class Population:
     layout: RegisterLayout = field(default_factory=RegisterLayout)
     programs: dict[int, Program] = field(default_factory=dict)
     teams: dict[int, Team] = field(default_factory=dict)
+    memory_banks: set[int] = field(default_factory=set)
     next_program_id: int = 0
     next_team_id: int = 0
     next_bank_id: int = 0
 
     def new_bank(self) -> int:
-        """Returns a fresh memory bank id."""
+        """Adds a fresh memory bank to the bank population and returns its id."""
+        bank = self.next_bank_id
+        self.memory_banks.add(bank)
         self.next_bank_id += 1
-        return self.next_bank_id - 1
+        return bank
 
     def add_program(self, instructions: np.ndarray, action: int, bank: int) -> Program:
-        """Creates and stores a program with a fresh id."""
+        """Creates and stores a program with a fresh id.
+
+        A ``bank`` id not yet in the bank population joins it (and the bank counter moves
+        past it), so a program always points to an existing bank.
+        """
+        bank = int(bank)
+        if bank < 0:
+            raise ValueError(f"memory bank id must be >= 0, got {bank}")
+        if bank not in self.memory_banks:
+            self.memory_banks.add(bank)
+            self.next_bank_id = max(self.next_bank_id, bank + 1)
         prog = Program(
-            self.next_program_id, np.asarray(instructions, dtype=np.int32), int(action), int(bank)
+            self.next_program_id, np.asarray(instructions, dtype=np.int32), int(action), bank
         )
         self.programs[prog.id] = prog
         self.next_program_id += 1
@@ -128,9 +153,24 @@ class Population:
         """Ids of the root teams (in-degree 0), in creation order."""
         return [tid for tid, d in self.in_degree().items() if d == 0]
 
-    def banks(self) -> set[int]:
+    def banks(self) -> list[int]:
+        """Ids of every memory bank of the population, ascending (fresh ones included)."""
+        return sorted(self.memory_banks)
+
+    def banks_in_use(self) -> set[int]:
         """Ids of the memory banks some program points to."""
         return {p.bank for p in self.programs.values()}
+
+    def top_up_banks(self, minimum: int) -> list[int]:
+        """Adds fresh (zeroed) banks until the bank population holds ``minimum`` banks.
+
+        Args:
+            minimum: The number of banks to reach (evolution passes the number of teams).
+
+        Returns:
+            The ids of the banks added, ascending.
+        """
+        return [self.new_bank() for _ in range(minimum - len(self.memory_banks))]
 
     def reachable(self, root: int) -> list[int]:
         """Team ids reachable from ``root`` (itself included), in depth-first order."""
@@ -147,10 +187,16 @@ class Population:
         return order
 
     def prune(self) -> None:
-        """Deletes programs no team holds (banks vanish with their last program)."""
+        """Deletes programs no team holds, then memory banks no program points to."""
         held = {pid for team in self.teams.values() for pid in team.programs}
         for pid in [pid for pid in self.programs if pid not in held]:
             del self.programs[pid]
+        self.memory_banks &= self.banks_in_use()
+
+
+def _require(cond: bool, message: str) -> None:
+    if not cond:
+        raise InvariantError(message)
 
 
 def check_invariants(pop: Population) -> None:
@@ -158,35 +204,38 @@ def check_invariants(pop: Population) -> None:
 
     Rules: every team holds >= 2 distinct existing programs, at least one of them atomic;
     every program is held by some team, has valid instructions, an atomic action in
-    {0, 1, 2} or a pointer to an existing team, and a bank id below ``next_bank_id``;
-    ids are below their counters.
+    {0, 1, 2} or a pointer to an existing team, and a bank of the bank population; ids
+    are below their counters (bank ids too).
 
     Args:
         pop: The population to check.
 
     Raises:
-        AssertionError: Naming the first rule broken.
+        InvariantError: Naming the first rule broken.
     """
     held: set[int] = set()
     for tid, team in pop.teams.items():
-        assert team.id == tid, f"team key {tid} holds team {team.id}"
-        assert 0 <= tid < pop.next_team_id, f"team id {tid} outside counter"
-        assert len(team.programs) >= 2, f"team {tid} has {len(team.programs)} programs"
-        assert len(set(team.programs)) == len(team.programs), f"team {tid} repeats a program"
+        _require(team.id == tid, f"team key {tid} holds team {team.id}")
+        _require(0 <= tid < pop.next_team_id, f"team id {tid} outside counter")
+        _require(len(team.programs) >= 2, f"team {tid} has {len(team.programs)} programs")
+        _require(len(set(team.programs)) == len(team.programs), f"team {tid} repeats a program")
         for pid in team.programs:
-            assert pid in pop.programs, f"team {tid} holds missing program {pid}"
-        assert any(pop.programs[pid].is_atomic for pid in team.programs), (
-            f"team {tid} has no atomic program"
+            _require(pid in pop.programs, f"team {tid} holds missing program {pid}")
+        _require(
+            any(pop.programs[pid].is_atomic for pid in team.programs),
+            f"team {tid} has no atomic program",
         )
         held.update(team.programs)
     for pid, prog in pop.programs.items():
-        assert prog.id == pid, f"program key {pid} holds program {prog.id}"
-        assert 0 <= pid < pop.next_program_id, f"program id {pid} outside counter"
-        assert pid in held, f"program {pid} is held by no team"
+        _require(prog.id == pid, f"program key {pid} holds program {prog.id}")
+        _require(0 <= pid < pop.next_program_id, f"program id {pid} outside counter")
+        _require(pid in held, f"program {pid} is held by no team")
         problem = valid_instructions(prog.instructions, pop.layout)
-        assert problem is None, f"program {pid}: {problem}"
+        _require(problem is None, f"program {pid}: {problem}")
         if prog.is_atomic:
-            assert prog.atomic_action < N_ACTIONS, f"program {pid} action {prog.action}"
+            _require(prog.atomic_action < N_ACTIONS, f"program {pid} action {prog.action}")
         else:
-            assert prog.action in pop.teams, f"program {pid} points to missing team"
-        assert 0 <= prog.bank < pop.next_bank_id, f"program {pid} bank {prog.bank}"
+            _require(prog.action in pop.teams, f"program {pid} points to missing team")
+        _require(prog.bank in pop.memory_banks, f"program {pid} points to missing bank {prog.bank}")
+    for bank in pop.memory_banks:
+        _require(0 <= bank < pop.next_bank_id, f"bank id {bank} outside counter")

@@ -52,7 +52,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 #: Operation codes, in op-code order.
 OP_NAMES: tuple[str, ...] = (
@@ -233,48 +232,6 @@ def valid_instructions(instructions: np.ndarray, layout: RegisterLayout) -> str 
         if values.min() < 0 or values.max() >= hi:
             return f"{name} out of range [0, {hi})"
     return None
-
-
-@njit(cache=True)
-def _effective_kernel(code: np.ndarray, n_r: int) -> np.ndarray:
-    live = np.zeros(n_r, dtype=np.bool_)
-    live[0] = True
-    mask = np.zeros(len(code), dtype=np.bool_)
-    for k in range(len(code) - 1, -1, -1):
-        op, dst, a, b = code[k, 0], code[k, 1], code[k, 2], code[k, 3]
-        cond = op >= OP_IF_LT
-        if dst < n_r:
-            if not live[dst]:
-                continue
-            if not cond:
-                live[dst] = False
-        mask[k] = True
-        if b < n_r:
-            live[b] = True
-        if a < n_r and not (OP_COS <= op <= OP_CUBE):
-            live[a] = True
-        if cond and dst < n_r:
-            live[dst] = True
-    return mask
-
-
-def effective_mask(instructions: np.ndarray, layout: RegisterLayout) -> np.ndarray:
-    """Marks the instructions that can affect ``r[0]`` or any memory register.
-
-    A backward liveness pass: the live set starts as ``{r[0]}``; every write to memory is
-    effective (memory is stateful and shared); a write to ``r[i]`` is effective only when
-    ``r[i]`` is live. An effective unconditional write kills its target, then its
-    operands become live (unary operations read only the second operand; a conditional
-    also reads its target).
-
-    Args:
-        instructions: int array ``(n, 4)``.
-        layout: Register sizes.
-
-    Returns:
-        Boolean array of length ``n``; False marks an intron.
-    """
-    return _effective_kernel(np.ascontiguousarray(instructions, dtype=np.int32), layout.n_registers)
 
 
 def disassemble(instructions: np.ndarray, layout: RegisterLayout) -> list[str]:

@@ -13,8 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mtpg.engine.compile import effective_mask
 from mtpg.model.graph import Population
-from mtpg.model.instructions import disassemble, effective_mask
+from mtpg.model.instructions import disassemble
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@
 :func:`prepare` turns a population and a root into an :class:`ExportGraph`: only the
 teams reachable from the root (depth-first from it, the root first), the programs they
 hold (in order of first use) with their introns removed exactly as the engine removes
-them (:func:`mtpg.model.instructions.effective_mask`), and the memory banks those
+them (:func:`mtpg.engine.compile.effective_mask`), and the memory banks those
 programs point to, all renumbered densely from 0. The code generators then only print.
 
 The execution semantics the generated code reproduces are those of
@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from mtpg.engine.compile import effective_mask
 from mtpg.export.fold import Operand, Statement, lower
 from mtpg.model.graph import Population
 from mtpg.model.instructions import (
@@ -35,7 +36,6 @@ from mtpg.model.instructions import (
     LOG_BIG,
     LOG_TINY,
     RegisterLayout,
-    effective_mask,
 )
 
 #: Numeric constants of the protected operation table, by the name the generated code uses.

@@ -119,9 +119,7 @@ def training_estimate(config: Any) -> dict[str, float]:
     programs = team.root_size * team.init_team_size + children * 2
     mean_length = (prog.init_max_length + 1) / 2
     instructions = programs * mean_length
-    population = (
-        programs * PROGRAM_BYTES + instructions * INSTRUCTION_BYTES + roots * TEAM_BYTES
-    )
+    population = programs * PROGRAM_BYTES + instructions * INSTRUCTION_BYTES + roots * TEAM_BYTES
     new_roots = max(team.root_size, children)
     train_eps = ev.train_episodes * len(steps)
     evaluation = evaluation_bytes(new_roots, train_eps, max(steps))
@@ -172,9 +170,7 @@ def check_training_fits(config: Any, available: int | None = None) -> dict[str, 
     return est
 
 
-def check_evaluation_fits(
-    n_episodes: int, max_steps: int, available: int | None = None
-) -> None:
+def check_evaluation_fits(n_episodes: int, max_steps: int, available: int | None = None) -> None:
     """Refuses an evaluation of one graph on ``n_episodes`` episodes that cannot fit.
 
     Raises:

@@ -49,9 +49,9 @@ from mtpg.io.checkpoint import (
 from mtpg.io.lock import DirLock, lock_dir
 from mtpg.io.rundir import (
     RunDir,
+    champion_filename,
     check_new_run_dir,
     check_resumable,
-    champion_filename,
     init_run_dir,
     roll_back,
     write_champions,

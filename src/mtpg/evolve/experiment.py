@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mtpg.config import ABLATIONS
+from mtpg.evolve.stopping import GracefulStop
 from mtpg.io.checkpoint import list_checkpoints
 from mtpg.io.rundir import is_run_dir
 
@@ -84,8 +85,13 @@ def execute(
     parallel: int = 1,
     workers: int = 1,
     log=print,
+    stop: GracefulStop | None = None,
 ) -> list[PlannedRun]:
     """Runs every unfinished run, ``parallel`` processes at a time.
+
+    When ``stop`` receives a signal, it is passed on to the running processes (which
+    stop at a generation boundary), no further run starts, and the running ones are
+    waited for; stopped runs are not counted as failed.
 
     Returns:
         The runs that failed (empty when all finished).
@@ -96,7 +102,15 @@ def execute(
             log(f"{r.path.name}: done")
     running: list[tuple[PlannedRun, subprocess.Popen]] = []
     failed = []
+    forwarded = False
     while todo or running:
+        if stop is not None and stop.signum is not None:
+            todo.clear()
+            if not forwarded:
+                for _, proc in running:
+                    if proc.poll() is None:
+                        proc.send_signal(stop.signum)
+                forwarded = True
         while todo and len(running) < parallel:
             run = todo.pop(0)
             log(f"{run.path.name}: {run.state(generations)} -> starting")
@@ -109,6 +123,7 @@ def execute(
                         run.command(train_args, generations, workers),
                         stdout=logfile,
                         stderr=subprocess.STDOUT,
+                        start_new_session=True,  # signals reach it once, passed on by us
                     ),
                 )
             )
@@ -118,7 +133,11 @@ def execute(
             if proc.poll() is not None:
                 running.remove(item)
                 ok = proc.returncode == 0
-                log(f"{run.path.name}: {'finished' if ok else f'failed ({proc.returncode})'}")
-                if not ok:
+                stopped = forwarded and proc.returncode >= 128
+                state = (
+                    "finished" if ok else "stopped" if stopped else f"failed ({proc.returncode})"
+                )
+                log(f"{run.path.name}: {state}")
+                if not (ok or stopped):
                     failed.append(run)
     return failed

@@ -281,10 +281,6 @@ def _mtpg(*args, **kw):
 
 
 def test_output_piped_into_head_ends_quietly(files):
-    cmd = f"{sys.executable} -m mtpg evaluate {files['R']} --episodes 3 | head -c 10"
-    res = subprocess.run(["bash", "-c", f"set -o pipefail; {cmd}"], capture_output=True, text=True)
-    assert res.stderr == ""
-    assert res.returncode in (0, 141)
     # a reader that is gone before the first write: the write fails with EPIPE at once
     probe = (
         "import os, sys; from mtpg.cli.main import main; r, w = os.pipe(); os.close(r);"

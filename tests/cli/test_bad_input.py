@@ -336,3 +336,11 @@ def test_read_only_directory_is_a_runtime_failure(tmp_path):
         parent.chmod(0o700)
     assert res.returncode == 1
     assert len(res.stderr.strip().splitlines()) == 1 and "Permission denied" in res.stderr
+
+
+def test_overrides_are_validated_together_in_any_order():
+    from mtpg.config import build_config
+
+    a = ["program.init_max_length=2000", "program.max_length=3000"]
+    assert build_config("demo", None, a) == build_config("demo", None, a[::-1])
+    assert build_config("demo", None, a).program.init_max_length == 2000

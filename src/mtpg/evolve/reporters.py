@@ -25,14 +25,24 @@ from typing import Any
 from mtpg.evolve.persist import state_to_payload
 from mtpg.evolve.trainer import Trainer, metric_columns, test_columns
 from mtpg.io.checkpoint import checkpoint_path, prune_checkpoints, save_checkpoint
-from mtpg.io.rundir import MetricsWriter, champion_filename, write_champions
+from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, MetricsWriter, champion_filename, write_champions
 from mtpg.io.serialize import save_graph
 from mtpg.testhook import point
 
-#: Test results of the champions, one row per task subset and test point.
-TESTS_FILE = "tests.csv"
-#: Graph files of the tested champions (full task set and single tasks) per test point.
-TESTS_DIR = "tests"
+__all__ = [
+    "TESTS_DIR",
+    "TESTS_FILE",
+    "CallbackReporter",
+    "CheckpointReporter",
+    "Generation",
+    "MetricsReporter",
+    "Reporter",
+    "TestsReporter",
+    "champion_graphs",
+    "generations",
+    "train",
+    "write_test_graphs",
+]
 
 
 @dataclass(frozen=True)

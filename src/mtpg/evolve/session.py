@@ -83,7 +83,9 @@ def read_run_config(run_dir: str | Path) -> RunConfig:
         raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
 
 
-def load_state(run_dir: str | Path, config: RunConfig) -> TrainerState | None:
+def load_state(
+    run_dir: str | Path, config: RunConfig, ckpt: Path | None = None
+) -> TrainerState | None:
     """Loads the last checkpoint of a run and checks that it belongs to it.
 
     Writes nothing.
@@ -91,6 +93,7 @@ def load_state(run_dir: str | Path, config: RunConfig) -> TrainerState | None:
     Args:
         run_dir: The run directory.
         config: The run's configuration (its ``config.toml``, with resumable changes).
+        ckpt: The checkpoint file (default: the run's latest).
 
     Returns:
         The state of the last committed generation, or None when there is none.
@@ -99,7 +102,7 @@ def load_state(run_dir: str | Path, config: RunConfig) -> TrainerState | None:
         CheckpointError: Naming the file: unreadable, invalid, of another run, or holding
             another generation than its name says.
     """
-    ckpt = latest_checkpoint(run_dir)
+    ckpt = ckpt or latest_checkpoint(run_dir)
     if ckpt is None:
         return None
     payload = load_checkpoint(ckpt)
@@ -159,15 +162,17 @@ class Session:
         else:
             check_new_run_dir(path)
         check_training_fits(config)
-        state = load_state(path, config) if resume else None
+        ckpt = latest_checkpoint(path) if resume else None
+        state = load_state(path, config, ckpt) if ckpt else None
         # -- first write --------------------------------------------------------------
         path.mkdir(parents=True, exist_ok=True)
         self.lock: DirLock | None = lock_dir(path, "the run directory")
         self.metrics: MetricsReporter | None = None
         self.tests: TestsReporter | None = None
         try:
-            if resume:  # another process may have committed before we got the lock
-                state = load_state(path, config)
+            if resume and latest_checkpoint(path) != ckpt:  # committed before our lock
+                ckpt = latest_checkpoint(path)
+                state = load_state(path, config, ckpt) if ckpt else None
             self.lock.claim()
             self.run = init_run_dir(path, to_toml(config), resume=resume)
             self.config = config

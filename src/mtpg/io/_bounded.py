@@ -17,8 +17,6 @@ from __future__ import annotations
 import gzip
 import io
 import os
-import zlib
-from pathlib import Path
 from typing import Any
 
 from mtpg.limits import available_memory, gib
@@ -86,8 +84,6 @@ def read_gzip_bounded(raw: bytes, max_bytes: int) -> bytes:
                 )
     try:
         return gzip.decompress(raw)
-    except zlib.error:
-        raise
     except MemoryError as exc:  # pragma: no cover - depends on the machine
         raise TooLargeError(f"inflates to {gib(total)}, more than fits in memory") from exc
 
@@ -106,11 +102,3 @@ def check_depth(value: Any, max_depth: int = MAX_DEPTH) -> None:
         if depth > max_depth:
             raise ValueError(f"data is nested deeper than {max_depth} levels")
         stack.extend((c, depth + 1) for c in children if isinstance(c, dict | list))
-
-
-def file_size(path: str | os.PathLike[str]) -> int:
-    """Size of a file in bytes (0 when it cannot be read)."""
-    try:
-        return Path(path).stat().st_size
-    except OSError:
-        return 0

@@ -177,7 +177,8 @@ class RunConfig:
     workers: int = 1
     """Threads evaluating episodes (results do not depend on it)."""
     checkpoint_interval: int = 10
-    """Generations between checkpoints (one is also written at exit)."""
+    """Generations between checkpoints (commits); one is also written when the run ends or
+    is stopped by a signal, always of a complete generation (docs/runs.md)."""
     program: ProgramConfig = field(default_factory=ProgramConfig)
     """Program settings."""
     team: TeamConfig = field(default_factory=TeamConfig)

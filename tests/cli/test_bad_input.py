@@ -344,3 +344,16 @@ def test_overrides_are_validated_together_in_any_order():
     a = ["program.init_max_length=2000", "program.max_length=3000"]
     assert build_config("demo", None, a) == build_config("demo", None, a[::-1])
     assert build_config("demo", None, a).program.init_max_length == 2000
+
+
+def test_permission_denied_is_a_runtime_failure(tmp_path, capsys, monkeypatch):
+    import mtpg.io.rundir
+
+    def refuse(path, data, before_replace=None):
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(mtpg.io.rundir, "atomic_write_bytes", refuse)
+    assert main(["train", *TINY, "--generations", "1", "--out", str(tmp_path / "run")]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert err[0].endswith("config.toml: Permission denied") and "Traceback" not in err[0]

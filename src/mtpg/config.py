@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.envs.core import TASK_NAMES
+from mtpg.limits import LIMITS
 
 
 class ConfigError(ValueError):
@@ -34,9 +35,13 @@ def _probabilities(obj: Any, section: str) -> None:
 
 
 def _positive(obj: Any, section: str, names: tuple[str, ...], minimum: int = 1) -> None:
+    """Checks ``minimum <= value <= LIMITS[field]`` (hard limits guard memory and time)."""
     for name in names:
         value = getattr(obj, name)
-        _check(value >= minimum, f"{section}.{name}", f"must be >= {minimum}", value)
+        key = name if section == "run" else f"{section}.{name}"
+        _check(value >= minimum, key, f"must be >= {minimum}", value)
+        if key in LIMITS:
+            _check(value <= LIMITS[key], key, f"must be <= {LIMITS[key]:,} (hard limit)", value)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -115,6 +120,12 @@ class TeamConfig:
         _positive(self, "team", ("root_size", "n_elite", "max_team_size"))
         _positive(self, "team", ("init_team_size",), minimum=2)
         _positive(self, "team", ("min_elite_total",), minimum=0)
+        _check(
+            self.max_team_size >= self.init_team_size,
+            "team.max_team_size",
+            "must be >= team.init_team_size",
+            self.max_team_size,
+        )
         _probabilities(self, "team")
 
 
@@ -173,7 +184,8 @@ class RunConfig:
     workers: int = 1
     """Threads evaluating episodes (results do not depend on it)."""
     checkpoint_interval: int = 10
-    """Generations between checkpoints (one is also written at exit)."""
+    """Generations between checkpoints (commits); one is also written when the run ends or
+    is stopped by a signal, always of a complete generation (docs/runs.md)."""
     program: ProgramConfig = field(default_factory=ProgramConfig)
     """Program settings."""
     team: TeamConfig = field(default_factory=TeamConfig)
@@ -259,10 +271,14 @@ def parse_override(text: str) -> dict[str, Any]:
     if "=" not in text:
         raise ConfigError(f"override {text!r} must look like section.field=value")
     key, raw = (s.strip() for s in text.split("=", 1))
+    if not key or any(not part for part in key.split(".")):
+        raise ConfigError(f"override {text!r} must look like section.field=value")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw  # a bare word: a string
+    except RecursionError:
+        raise ConfigError(f"override {text!r}: value is nested too deeply") from None
     out: dict[str, Any] = {}
     node = out
     *parents, leaf = key.split(".")
@@ -270,6 +286,34 @@ def parse_override(text: str) -> dict[str, Any]:
         node = node.setdefault(part, {})
     node[leaf] = value
     return out
+
+
+#: Largest configuration file read (bytes): far above any real one.
+MAX_TOML_BYTES = 1 << 20
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """Reads a TOML settings file, every problem as one :class:`ConfigError` naming it."""
+    path = Path(path)
+    try:
+        if path.is_dir():
+            raise ConfigError(f"{path}: is a directory, not a TOML file")
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_TOML_BYTES + 1)
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if len(raw) > MAX_TOML_BYTES:
+        raise ConfigError(f"{path}: larger than {MAX_TOML_BYTES} bytes; not a settings file")
+    try:
+        return tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
 
 
 def build_config(
@@ -293,17 +337,33 @@ def build_config(
         raise ConfigError(f"unknown preset {preset!r}; choose from {', '.join(PRESETS)}")
     config = merge(RunConfig(), PRESETS[preset])
     if toml_file is not None:
-        try:
-            data = tomllib.loads(Path(toml_file).read_text())
-        except tomllib.TOMLDecodeError as exc:
-            raise ConfigError(f"{toml_file}: not valid TOML: {exc}") from exc
+        data = read_toml(toml_file)
         try:
             config = merge(config, data)
         except ConfigError as exc:
             raise ConfigError(f"{toml_file}: {exc}") from exc
-    for text in overrides or []:
-        config = merge(config, parse_override(text))
-    return config
+    return merge_overrides(config, overrides or [])
+
+
+def _deep_update(into: dict[str, Any], data: dict[str, Any]) -> None:
+    for key, value in data.items():
+        if isinstance(value, dict) and isinstance(into.get(key), dict):
+            _deep_update(into[key], value)
+        else:
+            into[key] = value
+
+
+def merge_overrides(config: RunConfig, overrides: list[str]) -> RunConfig:
+    """Applies ``section.field=value`` overrides together, so their order does not matter.
+
+    All overrides are parsed into one nested dict (a later one wins for the same field)
+    and validated once, so e.g. raising ``program.init_max_length`` and
+    ``program.max_length`` works in either order.
+    """
+    data: dict[str, Any] = {}
+    for text in overrides:
+        _deep_update(data, parse_override(text))
+    return merge(config, data)
 
 
 def to_dict(config: RunConfig) -> dict[str, Any]:

@@ -212,7 +212,7 @@ def test_failed_write_keeps_previous_checkpoint(tmp_path, monkeypatch):
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr(os, "replace", broken_replace)
-    with pytest.raises(CheckpointError, match=r"gen-000001\.json\.gz: cannot write.*space"):
+    with pytest.raises(OSError, match=r"gen-000001\.json\.gz: cannot write.*space"):
         save_checkpoint(path, {"generation": 99})
     monkeypatch.undo()
     assert path.read_bytes() == before

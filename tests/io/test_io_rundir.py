@@ -34,6 +34,11 @@ def test_init_new_run(tmp_path):
 
 def test_init_refuses_existing_run_unless_resuming(tmp_path):
     run = init_run_dir(tmp_path / "run", TOML)
+    # a run that committed nothing may be started again (its creation is redone)
+    (run.path / "metrics.csv").write_text("generation\n")
+    init_run_dir(run.path, TOML)
+    assert sorted(p.name for p in run.path.iterdir()) == ["champions", "checkpoints", "config.toml"]
+    (run.checkpoints / "gen-000001.json.gz").write_bytes(b"")
     with pytest.raises(RunDirError, match="already holds an mtpg run"):
         init_run_dir(run.path, TOML)
     assert init_run_dir(run.path, None, resume=True).config.read_text() == TOML

@@ -58,17 +58,20 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.evaluate import evaluate_graph
     from mtpg.analysis.runs import normalise_scores
+    from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.tasks import MAX_STEPS
+    from mtpg.limits import check_evaluation_fits
 
-    if args.episodes < 1:
-        raise UsageError(f"--episodes must be >= 1, got {args.episodes}")
+    check_options(args)
     pop, root, meta, tasks = resolve_graph(Path(args.target))
-    if args.tasks:
-        tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    if args.tasks is not None:
+        tasks = task_list(args.tasks)
     unknown = [t for t in tasks if t not in TASK_NAMES]
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
+    check_evaluation_fits(len(tasks) * args.episodes, int(MAX_STEPS.max()))
     no_memory, memory = resolve_no_memory(args.memory, meta)
     scores = evaluate_graph(pop, root, tasks, args.episodes, args.seed, args.workers, no_memory)
     single = single_task_bests(Path(args.target), tasks)
@@ -102,6 +105,20 @@ def run(args: argparse.Namespace) -> int:
             line += f" {out[t]['normalised_single_task']:>9.3f}"
         print(line)
     return 0
+
+
+def check_options(args: argparse.Namespace) -> None:
+    """Refuses episode counts, seeds and thread counts outside their limits."""
+    from mtpg.cli.main import UsageError
+    from mtpg.limits import LIMITS
+
+    top = LIMITS["episodes"]
+    if not 1 <= args.episodes <= top:
+        raise UsageError(f"--episodes must be in 1..{top:,}, got {args.episodes}")
+    if not 0 <= args.seed <= 2**62:  # test seeds are 1,000,000 + seed + k in int64
+        raise UsageError(f"--seed must be in 0..{2**62}, got {args.seed}")
+    if not 1 <= args.workers <= LIMITS["workers"]:
+        raise UsageError(f"--workers must be in 1..{LIMITS['workers']}, got {args.workers}")
 
 
 def single_task_bests(target: Path, tasks: list[str]) -> dict[str, float]:

@@ -33,7 +33,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs the command."""
+    """Runs the command.
+
+    The experiment folder is locked for the whole command (a second experiment on it is
+    refused at once). A stop signal is passed on to the running ``mtpg train`` processes,
+    which stop at a generation boundary; no new run starts, and the command exits with
+    128 + the signal number. Rerunning it resumes every unfinished run.
+    """
     import sys
     from pathlib import Path
 
@@ -41,13 +47,18 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.main import UsageError, build_parser
     from mtpg.config import build_config
     from mtpg.evolve.experiment import execute, plan
+    from mtpg.evolve.stopping import GracefulStop, exit_code
+    from mtpg.io.lock import lock_dir
+    from mtpg.limits import check_training_fits
 
     if args.seeds < 1 or args.ablation_seeds < 0 or args.parallel < 1:
         raise UsageError("--seeds and --parallel must be >= 1, --ablation-seeds >= 0")
+    if max(args.seeds, args.ablation_seeds, args.parallel) > 1000:
+        raise UsageError("--seeds, --ablation-seeds and --parallel must be <= 1000")
     train_args = ["--preset", args.preset]
     if args.config:
         train_args += ["--config", args.config]
-    if args.tasks:
+    if args.tasks is not None:
         train_args += ["--tasks", args.tasks]
     for text in args.set:
         train_args += ["--set", text]
@@ -55,17 +66,30 @@ def run(args: argparse.Namespace) -> int:
     if args.generations is not None:
         train_args_ns.generations = args.generations
     config = build_config(args.preset, args.config, overrides(train_args_ns))  # validate early
+    check_training_fits(config)
     workers = max(1, config.workers // args.parallel)
     folder = Path(args.out)
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"--out {folder}: exists and is not a directory")
     runs = plan(folder, args.seeds, args.ablation_seeds)
-    failed = execute(
-        runs,
-        train_args,
-        config.generations,
-        args.parallel,
-        workers,
-        log=lambda m: print(m, file=sys.stderr),
-    )
+    folder.mkdir(parents=True, exist_ok=True)
+    with (
+        lock_dir(folder, "the experiment folder") as lock,
+        GracefulStop("mtpg experiment", "the running trainings stop") as stop,
+    ):
+        lock.claim()
+        failed = execute(
+            runs,
+            train_args,
+            config.generations,
+            args.parallel,
+            workers,
+            log=lambda m: print(m, file=sys.stderr),
+            stop=stop,
+        )
+    if stop.signum is not None:
+        print(f"stopped by {stop.name}; rerun the command to resume", file=sys.stderr)
+        return exit_code(stop.signum)
     if failed:
         names = ", ".join(r.path.name for r in failed)
         print(

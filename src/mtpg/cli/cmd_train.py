@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 
 ABLATION_FLAGS = {
@@ -47,13 +46,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def task_list(text: str, option: str = "--tasks") -> list[str]:
+    """The names of a comma-separated list option, refusing an empty one."""
+    from mtpg.cli.main import UsageError
+    from mtpg.envs.core import TASK_NAMES
+
+    names = [t.strip() for t in text.split(",") if t.strip()]
+    if not names:
+        raise UsageError(f"{option}: empty list; name at least one of {', '.join(TASK_NAMES)}")
+    return names
+
+
 def overrides(args: argparse.Namespace) -> list[str]:
     """The ``section.field=value`` overrides the options stand for."""
     from mtpg.config import ABLATIONS
 
     out = list(args.set)
-    if args.tasks:
-        names = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    if args.tasks is not None:
+        names = task_list(args.tasks)
         out.append("evaluation.tasks=[" + ", ".join(f'"{t}"' for t in names) + "]")
     for key in ("generations", "seed", "workers"):
         if getattr(args, key) is not None:
@@ -76,42 +86,54 @@ def _fresh_dir(base: str) -> str:
     return path
 
 
-def _terminate(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt
-
-
 def run(args: argparse.Namespace) -> int:
-    """Runs the command."""
-    from mtpg.cli.progress import Progress
-    from mtpg.config import build_config, merge, parse_override
-    from mtpg.evolve.session import Session, read_run_config
+    """Runs the command.
 
-    if args.resume:
-        config = read_run_config(args.resume)
-        for text in overrides(args):
-            config = merge(config, parse_override(text))
-        session = Session(args.resume, config, resume=True)
-    else:
-        config = build_config(args.preset, args.config, overrides(args))
-        out = args.out or _fresh_dir(f"runs/{args.preset}-seed{config.seed}")
-        session = Session(out, config)
-    cfg = session.config
-    print(
-        f"run directory: {session.run.path}  (generation {session.trainer.state.generation}"
-        f" of {cfg.generations}; tasks: {', '.join(cfg.evaluation.tasks)})",
-        file=sys.stderr,
-    )
-    progress = None if args.quiet else Progress(cfg.generations, cfg.evaluation.tasks)
-    signal.signal(signal.SIGTERM, _terminate)
-    try:
-        session.run_all(progress)
-    except KeyboardInterrupt:
+    Stop signals (SIGTERM, SIGINT, SIGHUP) end the run after the generation under way is
+    complete and committed; a second one stops at once. Either way the exit status is
+    128 + the signal number (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP) and the run resumes
+    exactly with ``--resume``.
+    """
+    from mtpg.cli.progress import Progress
+    from mtpg.config import build_config, merge_overrides
+    from mtpg.evolve.session import Session, read_run_config
+    from mtpg.evolve.stopping import GracefulStop, StopNow, exit_code
+
+    with GracefulStop("mtpg train", "the generation under way is committed") as stop:
+        if args.resume:
+            config = merge_overrides(read_run_config(args.resume), overrides(args))
+            session = Session(args.resume, config, resume=True)
+        else:
+            config = build_config(args.preset, args.config, overrides(args))
+            out = args.out or _fresh_dir(f"runs/{args.preset}-seed{config.seed}")
+            session = Session(out, config)
+        cfg, where = session.config, session.run.path
+        print(
+            f"run directory: {where}  (generation {session.trainer.state.generation}"
+            f" of {cfg.generations}; tasks: {', '.join(cfg.evaluation.tasks)})",
+            file=sys.stderr,
+        )
+        progress = None if args.quiet else Progress(cfg.generations, cfg.evaluation.tasks)
+        try:
+            finished = session.run_all(progress, stop.requested)
+        except StopNow as exc:
+            if progress:
+                progress.close()
+            print(
+                f"stopped at once by {exc}; the generation under way was abandoned; "
+                f"mtpg train --resume {where} continues from generation "
+                f"{session.saved_generation}",
+                file=sys.stderr,
+            )
+            return exit_code(exc.signum)
+    if not finished and stop.signum is not None:
         if progress:
             progress.close()
         print(
-            f"interrupted; checkpoint written; resume with: mtpg train --resume {session.run.path}",
+            f"stopped by {stop.name} after generation {session.saved_generation} (committed); "
+            f"resume with: mtpg train --resume {where}",
             file=sys.stderr,
         )
-        return 130
-    print(f"done: {session.run.path}", file=sys.stderr)
+        return exit_code(stop.signum)
+    print(f"done: {where}", file=sys.stderr)
     return 0

@@ -3,13 +3,22 @@
 Each command lives in its own module ``mtpg.cli.cmd_<name>`` exposing
 ``register(subparsers)`` (adds its parser and sets ``func``) and keeps heavy imports
 inside its ``run`` function, so ``mtpg --help`` stays fast.
+
+Every failure a user can cause or meet is one line on standard error naming the file or
+field and the problem, with exit status 2 for bad input (options, settings, files) and 1
+for a failure of the machine (disk full, permission denied, out of memory, a directory in
+use by another process). ``--debug`` (before or after the command) adds the traceback.
+Output piped into a program that stops reading (``mtpg ... | head -1``) ends quietly with
+status 141, as if killed by SIGPIPE.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
+import traceback
 
 #: Command modules, in the order ``mtpg --help`` lists them.
 COMMAND_MODULES = (
@@ -25,9 +34,20 @@ COMMAND_MODULES = (
     "mtpg.cli.cmd_export",
 )
 
+#: Exit status for bad input, a runtime failure and a closed output pipe.
+EXIT_USAGE, EXIT_FAILURE, EXIT_PIPE = 2, 1, 141
+
 
 class UsageError(Exception):
     """A user error that the CLI reports as one line and exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (the usage is in ``--help``)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        """Prints one line and exits with status 2."""
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -36,10 +56,11 @@ def build_parser() -> argparse.ArgumentParser:
     Returns:
         The parser; each sub-parser sets ``func`` to its command's ``run``.
     """
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="mtpg",
         description="Tangled Program Graphs with temporal memory for multi-task RL.",
     )
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:
@@ -49,7 +70,51 @@ def build_parser() -> argparse.ArgumentParser:
                 raise
             continue
         module.register(subparsers)
+    for sub in subparsers.choices.values():
+        sub.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help=argparse.SUPPRESS
+        )
     return parser
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def classify(exc: BaseException) -> tuple[int, str]:
+    """The exit status and the one-line message of an error.
+
+    Bad input (status 2): :class:`UsageError`, ``ValueError`` (every configuration, file
+    format, checkpoint and run-directory error derives from it), a missing file or a
+    directory given for a file. A failure of the machine (status 1): other ``OSError``
+    (disk full, permission, read-only file system), ``MemoryError``, a locked directory.
+    """
+    from mtpg.io.lock import LockedError
+
+    if isinstance(exc, OSError) and exc.strerror:
+        where = f"{exc.filename}: " if exc.filename else ""
+        text = f"{where}{exc.strerror}"
+        bad_input = isinstance(exc, FileNotFoundError | IsADirectoryError | NotADirectoryError)
+        return (EXIT_USAGE if bad_input else EXIT_FAILURE), _one_line(text)
+    if isinstance(exc, UsageError | ValueError | FileNotFoundError):
+        return EXIT_USAGE, _one_line(str(exc))
+    if isinstance(exc, RecursionError):
+        return EXIT_USAGE, "input nested too deeply"
+    if isinstance(exc, MemoryError):
+        return EXIT_FAILURE, "out of memory"
+    if isinstance(exc, LockedError | OSError):
+        return EXIT_FAILURE, _one_line(str(exc))
+    text = f"internal error: {type(exc).__name__}: {exc} (run with --debug for the traceback)"
+    return EXIT_FAILURE, _one_line(text)
+
+
+def _silence_stdout() -> None:
+    """Points standard output at /dev/null so that exit does not fail flushing it."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -65,12 +130,33 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
-        return 2
+        return EXIT_USAGE
+    debug = args.debug or bool(os.environ.get("MTPG_DEBUG"))
     try:
-        return int(args.func(args) or 0)
-    except (UsageError, ValueError, FileNotFoundError) as exc:
-        print(f"mtpg {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return code
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_PIPE
+    except KeyboardInterrupt as exc:
+        import signal
+
+        from mtpg.evolve.stopping import exit_code
+
+        if debug:
+            traceback.print_exc()
+        print(f"mtpg {args.command}: interrupted", file=sys.stderr)
+        return exit_code(getattr(exc, "signum", signal.SIGINT))
+    except Exception as exc:  # every error: one line (with --debug, the traceback too)
+        code, text = classify(exc)
+        if debug:
+            traceback.print_exc()
+        try:
+            print(f"mtpg {args.command}: error: {text}", file=sys.stderr)
+        except BrokenPipeError:
+            pass
+        return code
 
 
 if __name__ == "__main__":

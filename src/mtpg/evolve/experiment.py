@@ -7,6 +7,7 @@ interrupted experiment continues where it stopped.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import time
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from mtpg.config import ABLATIONS
+from mtpg.evolve.stopping import GracefulStop, StopNow
 from mtpg.io.checkpoint import list_checkpoints
 from mtpg.io.rundir import is_run_dir
 
@@ -84,8 +86,14 @@ def execute(
     parallel: int = 1,
     workers: int = 1,
     log=print,
+    stop: GracefulStop | None = None,
 ) -> list[PlannedRun]:
     """Runs every unfinished run, ``parallel`` processes at a time.
+
+    When ``stop`` receives a signal, it is passed on to the running processes (which
+    stop at a generation boundary), no further run starts, and the running ones are
+    waited for; stopped runs are not counted as failed. A second signal is passed on
+    as well (they stop at once) before :class:`StopNow` propagates.
 
     Returns:
         The runs that failed (empty when all finished).
@@ -96,29 +104,51 @@ def execute(
             log(f"{r.path.name}: done")
     running: list[tuple[PlannedRun, subprocess.Popen]] = []
     failed = []
-    while todo or running:
-        while todo and len(running) < parallel:
-            run = todo.pop(0)
-            log(f"{run.path.name}: {run.state(generations)} -> starting")
-            run.path.parent.mkdir(parents=True, exist_ok=True)
-            logfile = open(run.path.parent / f"{run.path.name}.log", "a")  # noqa: SIM115
-            running.append(
-                (
-                    run,
-                    subprocess.Popen(
-                        run.command(train_args, generations, workers),
-                        stdout=logfile,
-                        stderr=subprocess.STDOUT,
-                    ),
+    forwarded = False
+    try:
+        while todo or running:
+            if stop is not None and stop.signum is not None:
+                todo.clear()
+                if not forwarded:
+                    for _, proc in running:
+                        if proc.poll() is None:
+                            proc.send_signal(stop.signum)
+                    forwarded = True
+            while todo and len(running) < parallel:
+                run = todo.pop(0)
+                log(f"{run.path.name}: {run.state(generations)} -> starting")
+                run.path.parent.mkdir(parents=True, exist_ok=True)
+                logfile = open(run.path.parent / f"{run.path.name}.log", "a")  # noqa: SIM115
+                running.append(
+                    (
+                        run,
+                        subprocess.Popen(
+                            run.command(train_args, generations, workers),
+                            stdout=logfile,
+                            stderr=subprocess.STDOUT,
+                            start_new_session=True,  # signals reach it once, passed on by us
+                        ),
+                    )
                 )
-            )
-        time.sleep(0.2)
-        for item in list(running):
-            run, proc = item
-            if proc.poll() is not None:
-                running.remove(item)
-                ok = proc.returncode == 0
-                log(f"{run.path.name}: {'finished' if ok else f'failed ({proc.returncode})'}")
-                if not ok:
-                    failed.append(run)
+            time.sleep(0.2)
+            for item in list(running):
+                run, proc = item
+                if proc.poll() is not None:
+                    running.remove(item)
+                    ok = proc.returncode == 0
+                    stopped = forwarded and proc.returncode >= 128
+                    code = proc.returncode
+                    log(
+                        f"{run.path.name}: "
+                        + ("finished" if ok else "stopped" if stopped else f"failed ({code})")
+                    )
+                    if not (ok or stopped):
+                        failed.append(run)
+    except StopNow:  # a second signal: the trainings stop at once too
+        for _, proc in running:
+            if proc.poll() is None:
+                proc.send_signal(stop.signum if stop and stop.signum else signal.SIGTERM)
+        for _, proc in running:
+            proc.wait()
+        raise
     return failed

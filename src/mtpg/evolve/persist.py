@@ -1,14 +1,56 @@
-"""Conversion of the run state to and from a JSON-native checkpoint payload."""
+"""Conversion of the run state to and from a JSON-native checkpoint payload.
+
+A payload records the identity of its run (:func:`run_identity`: a digest of the
+resolved configuration without the settings a resume may change) and its generation, so
+that a checkpoint copied from another run, or renamed, is refused instead of silently
+continuing a different run.
+"""
 
 from __future__ import annotations
 
+import hashlib
+import json
 from typing import Any
 
 import numpy as np
 
-from mtpg.config import RunConfig, from_dict, to_dict
+from mtpg.config import ConfigError, RunConfig, from_dict, to_dict
+from mtpg.envs.core import N_OBS
 from mtpg.evolve.trainer import TrainerState
 from mtpg.io.serialize import FormatError, population_from_dict, population_to_dict
+
+#: Settings a resumed run may change: they do not alter what the run computes.
+RESUMABLE_CHANGES = ("generations", "workers", "checkpoint_interval")
+
+
+def identity_fields(config: RunConfig) -> dict[str, Any]:
+    """The resolved configuration without :data:`RESUMABLE_CHANGES`."""
+    data = to_dict(config)
+    for key in RESUMABLE_CHANGES:
+        data.pop(key)
+    return data
+
+
+def run_identity(config: RunConfig) -> str:
+    """A run's identity: the first 16 hex digits of the SHA-256 of :func:`identity_fields`.
+
+    Seed, tasks and every setting that changes what the run computes enter it; two runs
+    with the same identity compute the same generations.
+    """
+    text = json.dumps(identity_fields(config), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def config_differences(a: RunConfig, b: RunConfig) -> list[str]:
+    """Dotted names of the identity fields in which two configurations differ."""
+    out = []
+    da, db = identity_fields(a), identity_fields(b)
+    for key in da:
+        if isinstance(da[key], dict):
+            out += [f"{key}.{k}" for k in da[key] if da[key][k] != db[key][k]]
+        elif da[key] != db[key]:
+            out.append(key)
+    return out
 
 
 def state_to_payload(state: TrainerState) -> dict[str, Any]:
@@ -18,6 +60,7 @@ def state_to_payload(state: TrainerState) -> dict[str, Any]:
     state is PCG64's own dict, so a resumed run repeats the uninterrupted one.
     """
     return {
+        "run": run_identity(state.config),
         "config": to_dict(state.config),
         "generation": state.generation,
         "population": population_to_dict(state.population),
@@ -35,7 +78,7 @@ def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig
         The state and the configuration stored with it.
 
     Raises:
-        FormatError: When a part is missing or malformed.
+        FormatError: When a part is missing, malformed or inconsistent.
     """
     try:
         config = from_dict(payload["config"])
@@ -50,11 +93,40 @@ def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig
             champions=[int(r) for r in payload["champions"]],
             rng=rng,
         )
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         if isinstance(exc, FormatError):
             raise
+        if isinstance(exc, ConfigError):
+            raise FormatError(f"run state: config: {exc}") from exc
         raise FormatError(f"run state: {type(exc).__name__}: {exc}") from exc
-    missing = [r for r in state.scores if r not in state.population.teams]
+    _check_consistent(state, payload)
+    return state, config
+
+
+def _check_consistent(state: TrainerState, payload: dict[str, Any]) -> None:
+    cfg, pop = state.config, state.population
+    run = payload.get("run")
+    if run is not None and run != run_identity(cfg):
+        raise FormatError("run state: its run identity does not match its configuration")
+    if state.generation < 0:
+        raise FormatError(f"run state: generation must be >= 0, got {state.generation}")
+    layout = pop.layout
+    want = (cfg.program.n_registers, cfg.program.n_memory, N_OBS)
+    if state.generation > 0 and (layout.n_registers, layout.n_memory, layout.n_obs) != want:
+        raise FormatError(
+            f"run state: population layout {layout} does not match the configuration {want}"
+        )
+    missing = [r for r in state.scores if r not in pop.teams]
     if missing:
         raise FormatError(f"run state: scored roots {missing[:3]} are not in the population")
-    return state, config
+    n_tasks = len(cfg.evaluation.tasks)
+    bad = [r for r, row in state.scores.items() if row.shape != (n_tasks,)]
+    if bad:
+        raise FormatError(f"run state: root {bad[0]} has scores for the wrong number of tasks")
+    if state.generation > 0:
+        subsets = cfg.evaluation.n_subsets
+        if len(state.champions) != subsets:
+            raise FormatError(f"run state: needs the champions of {subsets} task subsets")
+        unscored = [r for r in state.champions if r not in state.scores]
+        if unscored:
+            raise FormatError(f"run state: champion {unscored[0]} has no score")

@@ -1,44 +1,65 @@
-"""A training run bound to a run directory: metrics, checkpoints, champions, resume.
+"""A training run bound to a run directory: one run, one process, exact resume.
 
-A run killed at any moment resumes from its last checkpoint: metrics rows written after
-it are dropped and the generations are run again, reproducing them exactly (all but the
-timing columns), because the checkpoint holds the whole state including the generator.
+Guarantees (see ``docs/runs.md``):
+
+* **One run per directory.** Checkpoints record the run's identity and generation; a
+  checkpoint of another run, or one whose content disagrees with its file name, is
+  refused before anything is written.
+* **One process per directory.** The directory's lock (:mod:`mtpg.io.lock`) is held
+  from before the first write to the end; a second process is refused at once.
+* **Generations are transactions.** The checkpoint is the commit point (written by
+  :class:`mtpg.evolve.reporters.CheckpointReporter`, never from a half-made
+  generation). On resume everything after the last checkpoint is rolled back: rows of
+  later generations dropped, their test folders and temporary files removed, champions
+  rewritten from the checkpoint. The generations are then run again, reproducing the
+  uninterrupted run exactly (all but the timing columns), because the checkpoint holds
+  the whole state including the generator.
 """
 
 from __future__ import annotations
 
-import time
 import tomllib
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from mtpg.config import ConfigError, RunConfig, from_dict, to_dict, to_toml
-from mtpg.evolve.persist import state_from_payload, state_to_payload
-from mtpg.evolve.trainer import Trainer, metric_columns, test_columns
+from mtpg.config import ConfigError, RunConfig, from_dict, to_toml
+from mtpg.evolve.persist import (
+    RESUMABLE_CHANGES,
+    config_differences,
+    run_identity,
+    state_from_payload,
+)
+from mtpg.evolve.reporters import (
+    TESTS_FILE,
+    CallbackReporter,
+    CheckpointReporter,
+    MetricsReporter,
+    TestsReporter,
+    champion_graphs,
+    train,
+)
+from mtpg.evolve.trainer import Trainer, TrainerState
 from mtpg.io.checkpoint import (
     CheckpointError,
-    checkpoint_path,
+    checkpoint_generation,
     latest_checkpoint,
     load_checkpoint,
-    prune_checkpoints,
-    save_checkpoint,
 )
+from mtpg.io.lock import DirLock, lock_dir
 from mtpg.io.rundir import (
-    MetricsWriter,
     RunDir,
     champion_filename,
+    check_new_run_dir,
+    check_resumable,
     init_run_dir,
+    roll_back,
     write_champions,
 )
-from mtpg.io.serialize import FormatError, save_graph
+from mtpg.io.serialize import FormatError
+from mtpg.limits import check_training_fits
 
-#: Test results of the champions, one row per task subset and test point.
-TESTS_FILE = "tests.csv"
-#: Graph files of the tested champions (full task set and single tasks) per test point.
-TESTS_DIR = "tests"
-#: Settings a resumed run may change: they do not alter what the run computes.
-RESUMABLE_CHANGES = ("generations", "workers", "checkpoint_interval")
+__all__ = ["RESUMABLE_CHANGES", "TESTS_FILE", "Session", "read_run_config"]
 
 Callback = Callable[[dict[str, float], Trainer], None]
 
@@ -47,131 +68,182 @@ def read_run_config(run_dir: str | Path) -> RunConfig:
     """Reads the resolved configuration stored in a run directory."""
     path = RunDir(Path(run_dir)).config
     try:
-        return from_dict(tomllib.loads(path.read_text(encoding="utf-8")))
-    except (OSError, tomllib.TOMLDecodeError, ConfigError) as exc:
+        text = path.read_text(encoding="utf-8")
+    except (FileNotFoundError, NotADirectoryError):
+        check_resumable(run_dir)  # says why when the directory holds no run
+        raise ConfigError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
+        raise ConfigError(f"{path}: cannot read: {why}") from exc
+    try:
+        return from_dict(tomllib.loads(text))
+    except (tomllib.TOMLDecodeError, ConfigError) as exc:
         raise ConfigError(f"{path}: {exc}") from exc
+    except RecursionError:
+        raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
+
+
+def load_state(
+    run_dir: str | Path, config: RunConfig, ckpt: Path | None = None
+) -> TrainerState | None:
+    """Loads the last checkpoint of a run and checks that it belongs to it.
+
+    Writes nothing.
+
+    Args:
+        run_dir: The run directory.
+        config: The run's configuration (its ``config.toml``, with resumable changes).
+        ckpt: The checkpoint file (default: the run's latest).
+
+    Returns:
+        The state of the last committed generation, or None when there is none.
+
+    Raises:
+        CheckpointError: Naming the file: unreadable, invalid, of another run, or holding
+            another generation than its name says.
+    """
+    ckpt = ckpt or latest_checkpoint(run_dir)
+    if ckpt is None:
+        return None
+    payload = load_checkpoint(ckpt)
+    try:
+        state, stored = state_from_payload(payload)
+    except FormatError as exc:
+        raise CheckpointError(f"{ckpt}: not a valid run state: {exc}") from exc
+    named = checkpoint_generation(ckpt)
+    if state.generation != named:
+        raise CheckpointError(
+            f"{ckpt}: holds generation {state.generation} but its name says {named}; "
+            "refusing it (nothing was changed)"
+        )
+    if run_identity(stored) != run_identity(config):
+        diff = ", ".join(config_differences(stored, config)) or "identity"
+        raise CheckpointError(
+            f"{ckpt}: belongs to another run (differs from this run's config.toml in {diff}); "
+            "refusing it (nothing was changed)"
+        )
+    state.config = config
+    return state
 
 
 class Session:
     """Runs a :class:`Trainer` inside a run directory.
+
+    Everything is checked before the first write: the directory, the configuration's
+    memory and work (:func:`mtpg.limits.check_training_fits`) and, on resume, the last
+    checkpoint. Then the directory is locked, created or rolled back to its last
+    committed generation. Call :meth:`run_all` (or :meth:`close`) to release it.
 
     Args:
         run_dir: The run directory.
         config: Configuration of a new run; for a resumed run, None or a configuration
             that differs from the stored one only in :data:`RESUMABLE_CHANGES`.
         resume: Continue the run in ``run_dir`` from its last checkpoint.
+
+    Raises:
+        ConfigError, RunDirError, CheckpointError, BudgetError: Bad input; nothing
+            was changed.
+        LockedError: Another process uses the directory; nothing was changed.
     """
 
     def __init__(
         self, run_dir: str | Path, config: RunConfig | None = None, resume: bool = False
     ) -> None:
+        path = Path(run_dir)
         if resume:
-            stored = read_run_config(run_dir)
+            check_resumable(path)
+            stored = read_run_config(path)
             if config is not None:
                 _check_compatible(stored, config)
                 stored = replace(stored, **{k: getattr(config, k) for k in RESUMABLE_CHANGES})
             config = stored
         elif config is None:
             raise ConfigError("a new run needs a configuration")
-        state = None
-        ckpt = latest_checkpoint(run_dir) if resume else None
-        if ckpt is not None:  # read before anything is written: a bad file changes nothing
-            try:
-                state, _ = state_from_payload(load_checkpoint(ckpt))
-            except FormatError as exc:
-                raise CheckpointError(f"{ckpt}: not a valid run state: {exc}") from exc
-            state.config = config
-        self.run = init_run_dir(run_dir, to_toml(config), resume=resume)
-        self.trainer = Trainer(config, state)
-        self.config = config
-        self.metrics = MetricsWriter(self.run.metrics, metric_columns(config.evaluation.tasks))
-        self.metrics.truncate_after(self.trainer.state.generation)
-        self.tests = MetricsWriter(
-            self.run.path / TESTS_FILE, test_columns(config.evaluation.tasks)
-        )
-        self.tests.truncate_after(self.trainer.state.generation)
-        self.saved_generation = self.trainer.state.generation
-
-    def run_all(self, on_generation: Callback | None = None) -> None:
-        """Runs the remaining generations; checkpoints every interval and on any exit."""
+        else:
+            check_new_run_dir(path)
+        check_training_fits(config)
+        ckpt = latest_checkpoint(path) if resume else None
+        state = load_state(path, config, ckpt) if ckpt else None
+        # -- first write --------------------------------------------------------------
+        path.mkdir(parents=True, exist_ok=True)
+        self.lock: DirLock | None = lock_dir(path, "the run directory")
+        self.metrics: MetricsReporter | None = None
+        self.tests: TestsReporter | None = None
         try:
-            while not self.trainer.done:
-                row = self.trainer.run_generation()
-                if self.trainer.test_due():
-                    start = time.perf_counter()
-                    self.test()
-                    row["t_test"] = time.perf_counter() - start
-                    row["t_total"] += row["t_test"]
-                self.metrics.append(row)
-                if on_generation is not None:
-                    on_generation(row, self.trainer)
-                if self.trainer.state.generation % self.config.checkpoint_interval == 0:
-                    self.checkpoint()
-        finally:
-            if self.trainer.state.generation != self.saved_generation:
-                self.checkpoint()
-            self.metrics.close()
-            self.tests.close()
+            if resume and latest_checkpoint(path) != ckpt:  # committed before our lock
+                ckpt = latest_checkpoint(path)
+                state = load_state(path, config, ckpt) if ckpt else None
+            self.lock.claim()
+            self.run = init_run_dir(path, to_toml(config), resume=resume)
+            self.config = config
+            self.trainer = Trainer(config, state)
+            self._roll_back()
+        except BaseException:
+            self.close()
+            raise
+        self.checkpoints = CheckpointReporter(
+            self.run.path, config.checkpoint_interval, self.trainer.state.generation
+        )
 
-    def test(self) -> list[dict[str, float | int | str]]:
-        """Tests every subset's champion and keeps the graphs of the full set and each task.
+    def _roll_back(self) -> None:
+        """Makes the directory hold exactly the last committed generation."""
+        gen = self.trainer.state.generation
+        tasks = self.config.evaluation.tasks
+        roll_back(self.run.path, gen)
+        self.metrics = MetricsReporter(self.run.metrics, tasks)
+        self.metrics.writer.truncate_after(gen)
+        self.tests = TestsReporter(self.run.path, tasks)
+        self.tests.writer.truncate_after(gen)
+        graphs = champion_graphs(self.trainer) if gen > 0 else {}
+        write_champions(self.run.path, graphs)
+        keep = {champion_filename(names) for names in graphs}
+        for entry in self.run.champions.glob("*.json"):
+            if entry.name not in keep:
+                entry.unlink()
 
-        Rows go to ``tests.csv``; graph files to ``tests/gen-NNNNNN/<subset>.json``.
+    def run_all(
+        self, on_generation: Callback | None = None, should_stop: Callable[[], bool] | None = None
+    ) -> bool:
+        """Runs the remaining generations, then releases the directory.
+
+        Args:
+            on_generation: Called with each metrics row and the trainer (e.g. progress).
+            should_stop: Asked before each generation; True ends the run there, after
+                committing the last completed generation.
+
+        Returns:
+            True when every configured generation has run, False when stopped early.
         """
-        state = self.trainer.state
-        rows = self.trainer.test_champions()
-        for row in rows:
-            self.tests.append(row)
-        keep = {}
-        n = len(self.config.evaluation.tasks)
-        for k, row in enumerate(rows):
-            names = self.trainer.subset_names(k)
-            if len(names) in (1, n):
-                meta = {
-                    "generation": state.generation,
-                    "seed": self.config.seed,
-                    "test": {t: row[f"test_{t}"] for t in self.config.evaluation.tasks},
-                    "test_episodes": self.config.evaluation.test_episodes,
-                    "no_memory": self.config.evaluation.no_memory,
-                }
-                keep[names] = (state.population, int(row["root"]), meta)
-        folder = self.run.path / TESTS_DIR / f"gen-{state.generation:06d}"
-        for names, (pop, root, meta) in keep.items():
-            folder.mkdir(parents=True, exist_ok=True)
-            save_graph(folder / champion_filename(names), pop, root, meta)
-        return rows
+        reporters = [self.metrics, self.tests, self.checkpoints]
+        if on_generation is not None:
+            reporters.append(CallbackReporter(on_generation))
+        try:
+            return train(self.trainer, reporters, should_stop)
+        finally:
+            self.close()
 
     def checkpoint(self) -> Path:
-        """Writes the champions and an atomic checkpoint of the current generation."""
-        state = self.trainer.state
-        champions = {}
-        for k, root in enumerate(state.champions):
-            names = self.trainer.subset_names(k)
-            scores = state.scores[root]
-            meta = {
-                "generation": state.generation,
-                "seed": self.config.seed,
-                "train_scores": {
-                    t: float(scores[self.config.evaluation.tasks.index(t)]) for t in names
-                },
-                "no_memory": self.config.evaluation.no_memory,
-            }
-            champions[names] = (state.population, root, meta)
-        write_champions(self.run.path, champions)
-        path = checkpoint_path(self.run.path, state.generation)
-        save_checkpoint(path, state_to_payload(state))
-        prune_checkpoints(self.run.path, keep=2)
-        self.saved_generation = state.generation
-        return path
+        """Commits the current generation now (champions, then the checkpoint)."""
+        return self.checkpoints.commit(self.trainer)
+
+    @property
+    def saved_generation(self) -> int:
+        """The last committed generation."""
+        return self.checkpoints.saved_generation
+
+    def close(self) -> None:
+        """Closes the files and releases the directory's lock."""
+        for reporter in (self.metrics, self.tests):
+            if reporter is not None:
+                reporter.close()
+        if self.lock is not None:
+            self.lock.release()
+            self.lock = None
 
 
 def _check_compatible(stored: RunConfig, given: RunConfig) -> None:
-    a, b = to_dict(stored), to_dict(given)
-    for key in RESUMABLE_CHANGES:
-        a.pop(key)
-        b.pop(key)
-    if a != b:
-        diff = [k for k in a if a[k] != b[k]]
+    diff = config_differences(stored, given)
+    if diff:
         raise ConfigError(
             f"cannot resume with a different configuration (differs in {', '.join(diff)}); "
             f"only {', '.join(RESUMABLE_CHANGES)} may change"

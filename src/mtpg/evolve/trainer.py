@@ -19,6 +19,7 @@ from mtpg.envs.reference import TEST_SEED_BASE
 from mtpg.evolve.selection import select, task_subsets
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
+from mtpg.testhook import point
 
 #: Training episode ``k`` of every task uses episode seed ``TRAIN_SEED_BASE + k``.
 TRAIN_SEED_BASE = 0
@@ -142,8 +143,10 @@ class Trainer:
         else:
             self._vary(gen)
         t1 = time.perf_counter()
+        point("evaluate", gen)
         new_roots, result = self._evaluate()
         t2 = time.perf_counter()
+        point("select", gen)
         self._select()
         t3 = time.perf_counter()
         st.generation = gen
@@ -192,7 +195,9 @@ class Trainer:
         st = self.state
         varier = Varier(st.population, self.config, st.rng, gen)
         roots = sorted(st.scores)
-        for elites in st.elites:
+        for k, elites in enumerate(st.elites):
+            if k == len(st.elites) // 2:
+                point("vary", gen)
             pool = elites or roots
             for _ in range(self.config.elites_per_subset):
                 parent1 = pool[int(st.rng.integers(0, len(pool)))]

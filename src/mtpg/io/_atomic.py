@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 #: Suffix of the temporary files :func:`atomic_write_bytes` creates (and cleans up).
@@ -35,7 +36,9 @@ def fsync_dir(directory: Path) -> None:
         os.close(fd)
 
 
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+def atomic_write_bytes(
+    path: str | os.PathLike[str], data: bytes, before_replace: Callable[[], None] | None = None
+) -> None:
     """Writes ``data`` to ``path`` atomically.
 
     The bytes go to a temporary file in the same directory (``.NAME.XXXX.tmp``), which is
@@ -46,6 +49,8 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     Args:
         path: Destination file; its directory must exist.
         data: The complete new contents.
+        before_replace: Called after the data is flushed to the temporary file and before
+            the rename (a test hook: a stop there leaves only the temporary file).
 
     Raises:
         OSError: When writing or renaming fails.
@@ -62,6 +67,8 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        if before_replace is not None:
+            before_replace()
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):

@@ -20,10 +20,18 @@ import json
 import os
 import re
 import zlib
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
+from mtpg.io._bounded import (
+    MAX_CHECKPOINT_BYTES,
+    TooLargeError,
+    limit,
+    read_file_bounded,
+    read_gzip_bounded,
+)
 
 #: Format tag and version of a checkpoint file.
 CHECKPOINT_FORMAT = "mtpg-checkpoint"
@@ -88,16 +96,23 @@ def payload_digest(payload: Any) -> str:
     return hashlib.sha256(canonical_json(payload)).hexdigest()
 
 
-def save_checkpoint(path: str | os.PathLike[str], payload: dict[str, Any]) -> None:
+def save_checkpoint(
+    path: str | os.PathLike[str],
+    payload: dict[str, Any],
+    before_replace: Callable[[], None] | None = None,
+) -> None:
     """Writes a checkpoint atomically (temp file, fsync, rename, directory fsync).
 
     Args:
         path: Destination file; its directory must exist.
         payload: JSON-native run state.
+        before_replace: Called once the data is in the temporary file, just before it is
+            renamed into place (a test hook).
 
     Raises:
-        CheckpointError: When the payload is not JSON-native or the file cannot be
-            written; a previous file at ``path`` is then left intact.
+        CheckpointError: When the payload is not JSON-native.
+        OSError: When the file cannot be written (disk full, permission), naming it; a
+            previous file at ``path`` is then left intact.
     """
     if not isinstance(payload, dict):
         raise CheckpointError(f"{path}: payload must be a dict, got {type(payload).__name__}")
@@ -122,9 +137,9 @@ def save_checkpoint(path: str | os.PathLike[str], payload: dict[str, Any]) -> No
     )
     data = gzip.compress(doc, compresslevel=COMPRESS_LEVEL, mtime=0)
     try:
-        atomic_write_bytes(path, data)
+        atomic_write_bytes(path, data, before_replace)
     except OSError as exc:
-        raise CheckpointError(f"{path}: cannot write checkpoint: {exc}") from exc
+        raise OSError(exc.errno, f"{path}: cannot write checkpoint: {exc.strerror}") from exc
 
 
 def load_checkpoint(path: str | os.PathLike[str]) -> dict[str, Any]:
@@ -147,10 +162,13 @@ def load_checkpoint(path: str | os.PathLike[str]) -> dict[str, Any]:
         err.__cause__ = cause
         return err
 
+    max_bytes = limit(MAX_CHECKPOINT_BYTES, "MTPG_MAX_CHECKPOINT_BYTES")
     try:
-        raw = Path(path).read_bytes()
+        raw = read_file_bounded(path, max_bytes)
     except FileNotFoundError as exc:
         raise fail("checkpoint file does not exist", exc) from exc
+    except TooLargeError as exc:
+        raise fail(f"checkpoint {exc}", exc) from exc
     except OSError as exc:
         raise fail(f"cannot read checkpoint: {exc.strerror or exc}", exc) from exc
     if not raw:
@@ -159,7 +177,11 @@ def load_checkpoint(path: str | os.PathLike[str]) -> dict[str, Any]:
         kind = "plain JSON" if raw.lstrip()[:1] in (b"{", b"[") else "data"
         raise fail(f"not an mtpg checkpoint (not gzip-compressed; looks like {kind})")
     try:
-        doc_bytes = gzip.decompress(raw)
+        doc_bytes = read_gzip_bounded(raw, max_bytes)
+    except TooLargeError as exc:
+        raise fail(
+            f"checkpoint {exc} (set MTPG_MAX_CHECKPOINT_BYTES to read larger ones)", exc
+        ) from exc
     except EOFError as exc:
         raise fail("checkpoint is truncated (compressed stream ends early)", exc) from exc
     except (OSError, zlib.error, ValueError) as exc:
@@ -184,11 +206,17 @@ def load_checkpoint(path: str | os.PathLike[str]) -> dict[str, Any]:
         raise fail(f"checkpoint payload must be an object, got {type(payload).__name__}")
     try:
         actual = payload_digest(payload)
-    except (TypeError, ValueError) as exc:  # e.g. an overflowed float read as infinity
+    except (TypeError, ValueError, RecursionError) as exc:  # e.g. a float read as infinity
         raise fail(f"checkpoint is corrupt (payload: {exc})", exc) from exc
     if actual != digest:
         raise fail("checkpoint is corrupt (SHA-256 checksum mismatch)")
     return payload
+
+
+def checkpoint_generation(path: str | os.PathLike[str]) -> int | None:
+    """The generation a checkpoint's file name states, or None for another name."""
+    match = _NAME.match(Path(path).name)
+    return int(match.group(1)) if match else None
 
 
 def checkpoint_path(run_dir: str | os.PathLike[str], generation: int) -> Path:

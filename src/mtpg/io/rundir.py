@@ -6,6 +6,7 @@ Layout::
     RUN_DIR/metrics.csv        one row per generation (fixed header)
     RUN_DIR/checkpoints/       gen-NNNNNN.json.gz (see mtpg.io.checkpoint)
     RUN_DIR/champions/         one graph file per task subset, e.g. CartPole+Acrobot.json
+    RUN_DIR/.lock              held by the process writing the run (mtpg.io.lock)
 
 A directory is an mtpg run directory when it holds ``config.toml`` and ``checkpoints/``.
 """
@@ -15,20 +16,27 @@ from __future__ import annotations
 import csv
 import io
 import os
+import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from mtpg.envs.core import TASK_NAMES
-from mtpg.io._atomic import atomic_write_bytes
+from mtpg.io._atomic import atomic_write_bytes, is_temp_file
 from mtpg.io.checkpoint import CHECKPOINT_DIR
+from mtpg.io.lock import LOCK_FILE
 from mtpg.io.serialize import load_graph, save_graph
 from mtpg.model.graph import Population
+from mtpg.testhook import point
 
 CONFIG_FILE = "config.toml"
 METRICS_FILE = "metrics.csv"
 CHAMPION_DIR = "champions"
+#: Test results of the champions, one row per task subset and test point.
+TESTS_FILE = "tests.csv"
+#: Graph files of the tested champions per test point: ``tests/gen-NNNNNN/``.
+TESTS_DIR = "tests"
 
 
 class RunDirError(ValueError):
@@ -69,14 +77,87 @@ def is_run_dir(path: str | os.PathLike[str]) -> bool:
     return run.config.is_file() and run.checkpoints.is_dir()
 
 
+#: What a run directory may hold: a directory of only these names and no checkpoint is a
+#: run that committed nothing (or whose creation was interrupted), which may be restarted.
+RUN_NAMES = frozenset(
+    {
+        CONFIG_FILE,
+        METRICS_FILE,
+        CHECKPOINT_DIR,
+        CHAMPION_DIR,
+        LOCK_FILE,
+        TESTS_FILE,
+        TESTS_DIR,
+    }
+)
+
+
+def _has_checkpoint(run: RunDir) -> bool:
+    return run.checkpoints.is_dir() and any(
+        e.name.startswith("gen-") and not is_temp_file(e.name) for e in run.checkpoints.iterdir()
+    )
+
+
+def check_new_run_dir(path: str | os.PathLike[str]) -> bool:
+    """Checks, without changing anything, that a new run may be created in ``path``.
+
+    Allowed are a missing or empty directory and one left by a run that committed
+    nothing: an interrupted creation (no ``config.toml`` yet) or a run stopped before its
+    first checkpoint, holding only the names a run writes (:data:`RUN_NAMES`).
+
+    Returns:
+        True when ``path`` holds such leftovers, which creation will clear.
+
+    Raises:
+        RunDirError: When ``path`` is a file, holds a run with a checkpoint or holds
+            anything else.
+    """
+    run = RunDir(Path(path))
+    if run.path.exists() and not run.path.is_dir():
+        raise RunDirError(f"{run.path}: exists and is not a directory")
+    if not run.path.exists():
+        return False
+    entries = sorted(e.name for e in run.path.iterdir())
+    foreign = [n for n in entries if n not in RUN_NAMES and not is_temp_file(n)]
+    if foreign:
+        shown = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
+        raise RunDirError(
+            f"{run.path}: directory is not empty and is not an mtpg run directory "
+            f"(contains {shown}); choose a new or empty directory"
+        )
+    if _has_checkpoint(run):
+        raise RunDirError(
+            f"{run.path}: already holds an mtpg run; resume it (mtpg train --resume "
+            f"{run.path}) or choose another directory"
+        )
+    return bool(entries)
+
+
+def _clear_leftovers(run: RunDir) -> None:
+    """Removes what a run that committed nothing left behind (all but the lock file)."""
+    for entry in run.path.iterdir():
+        if entry.name == LOCK_FILE:
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry)
+        else:
+            entry.unlink()
+
+
 def init_run_dir(
     path: str | os.PathLike[str], config_toml: str | None, resume: bool = False
 ) -> RunDir:
     """Creates a run directory, or opens an existing one to resume it.
 
-    A new run needs a missing or empty directory. Resuming needs an existing run; its
-    ``config.toml`` is replaced by ``config_toml`` when given (the caller checks that the
-    change is compatible) and kept when ``config_toml`` is None.
+    A new run needs a missing or empty directory, or one a run left without committing
+    anything (see :func:`check_new_run_dir`; its leftovers are cleared). Creation writes
+    ``checkpoints/`` and ``champions/`` first and ``config.toml`` (atomically) last, so
+    a directory is a run exactly when its creation completed. Resuming needs an existing
+    run; its ``config.toml`` is replaced by ``config_toml`` when given (the caller checks
+    that the change is compatible) and kept when ``config_toml`` is None.
+
+    The caller holds the directory's lock (:mod:`mtpg.io.lock`) when other processes may
+    use it.
 
     Args:
         path: The run directory.
@@ -92,31 +173,77 @@ def init_run_dir(
             is True).
     """
     run = RunDir(Path(path))
-    if run.path.exists() and not run.path.is_dir():
-        raise RunDirError(f"{run.path}: exists and is not a directory")
-    if is_run_dir(run.path):
-        if not resume:
-            raise RunDirError(
-                f"{run.path}: already holds an mtpg run; resume it or choose another directory"
-            )
-    elif resume:
-        raise RunDirError(f"{run.path}: holds no mtpg run to resume")
+    if resume:
+        check_resumable(run.path)
     else:
-        entries = sorted(e.name for e in run.path.iterdir()) if run.path.exists() else []
-        if entries:
-            shown = ", ".join(entries[:5]) + (", ..." if len(entries) > 5 else "")
-            raise RunDirError(
-                f"{run.path}: directory is not empty and is not an mtpg run directory "
-                f"(contains {shown}); choose a new or empty directory"
-            )
         if config_toml is None:
             raise RunDirError(f"{run.path}: a new run needs its configuration")
-    run.path.mkdir(parents=True, exist_ok=True)
+        if check_new_run_dir(run.path):
+            _clear_leftovers(run)
+        run.path.mkdir(parents=True, exist_ok=True)
+        point("create", 0)
     run.checkpoints.mkdir(exist_ok=True)
     run.champions.mkdir(exist_ok=True)
     if config_toml is not None:
         atomic_write_bytes(run.config, config_toml.encode("utf-8"))
+    if not resume:
+        point("created", 0)
     return run
+
+
+def check_resumable(path: str | os.PathLike[str]) -> None:
+    """Raises :class:`RunDirError` unless ``path`` holds a run to resume, saying why."""
+    run = RunDir(Path(path))
+    if run.path.exists() and not run.path.is_dir():
+        raise RunDirError(f"{run.path}: exists and is not a directory")
+    if is_run_dir(run.path):
+        return
+    if run.path.is_dir():
+        names = [e.name for e in run.path.iterdir()]
+        if names and all(n in RUN_NAMES or is_temp_file(n) for n in names):
+            if run.config.is_file():
+                return  # created, sub-directories missing: resuming completes it
+            raise RunDirError(
+                f"{run.path}: holds no mtpg run to resume (its creation was interrupted "
+                f"before config.toml was written); start it again with mtpg train --out "
+                f"{run.path}"
+            )
+    raise RunDirError(f"{run.path}: holds no mtpg run to resume")
+
+
+def roll_back(path: str | os.PathLike[str], generation: int) -> list[Path]:
+    """Removes what a run wrote after ``generation`` besides rows: test folders, temp files.
+
+    Test folders ``tests/gen-NNNNNN`` of later generations go, and temporary files of
+    interrupted atomic writes anywhere in the run. (Rows are truncated by
+    :meth:`MetricsWriter.truncate_after`; champions are rewritten from the state.)
+
+    Returns:
+        The paths removed.
+    """
+    run = RunDir(Path(path))
+    removed = []
+    tests = run.path / TESTS_DIR
+    folders = [run.path, run.checkpoints, run.champions, tests]
+    if tests.is_dir():
+        for entry in sorted(tests.iterdir()):
+            if entry.is_dir() and entry.name.startswith("gen-"):
+                try:
+                    gen = int(entry.name[4:])
+                except ValueError:
+                    continue
+                if gen > generation:
+                    shutil.rmtree(entry)
+                    removed.append(entry)
+                else:
+                    folders.append(entry)
+    for folder in folders:
+        if folder.is_dir():
+            for entry in folder.iterdir():
+                if is_temp_file(entry.name) and entry.is_file():
+                    entry.unlink()
+                    removed.append(entry)
+    return removed
 
 
 class MetricsWriter:

@@ -22,7 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from mtpg.envs.core import N_OBS
 from mtpg.io._atomic import atomic_write_bytes
+from mtpg.io._bounded import MAX_GRAPH_BYTES, TooLargeError, check_depth, limit, read_file_bounded
 from mtpg.io._readable import dumps_readable
 from mtpg.model.graph import (
     N_ACTIONS,
@@ -46,6 +48,10 @@ GRAPH_FORMAT = "mtpg-graph"
 GRAPH_VERSION = 1
 
 _LAYOUT_KEYS = ("n_registers", "n_memory", "n_obs")
+#: Largest register-bank size a file may declare (``program.n_registers`` / ``n_memory``).
+MAX_BANK_SIZE = 256
+#: Integers in files must fit a signed 64-bit integer (ids become int64 arrays).
+_INT64 = (-(2**63), 2**63 - 1)
 
 
 class FormatError(ValueError):
@@ -72,6 +78,8 @@ def _int(value: Any, where: str, lo: int | None = None) -> int:
         raise FormatError(f"{where} must be an integer, got {value!r}")
     if lo is not None and value < lo:
         raise FormatError(f"{where} must be >= {lo}, got {value}")
+    if not _INT64[0] <= value <= _INT64[1]:
+        raise FormatError(f"{where} must fit a 64-bit integer, got {value}")
     return value
 
 
@@ -98,6 +106,13 @@ def _layout_from(value: Any) -> RegisterLayout:
     extra = sorted(set(obj) - set(_LAYOUT_KEYS))
     if extra:
         raise FormatError(f"layout has unknown keys {extra}")
+    if sizes["n_obs"] != N_OBS:  # every task observes two values (mtpg.envs.core.N_OBS)
+        raise FormatError(
+            f"layout.n_obs must be {N_OBS} (the tasks' interface), got {sizes['n_obs']}"
+        )
+    for key in ("n_registers", "n_memory"):
+        if sizes[key] > MAX_BANK_SIZE:
+            raise FormatError(f"layout.{key} must be <= {MAX_BANK_SIZE}, got {sizes[key]}")
     return RegisterLayout(**sizes)
 
 
@@ -390,16 +405,25 @@ def load_graph(path: str | os.PathLike[str]) -> tuple[Population, int, dict[str,
     Raises:
         FormatError: For any problem (unreadable, not JSON, invalid graph), naming the file.
     """
+    if Path(path).is_dir():
+        raise FormatError(f"{path}: is a directory, not a graph file")
     try:
-        text = Path(path).read_bytes().decode("utf-8")
+        text = read_file_bounded(path, limit(MAX_GRAPH_BYTES, "MTPG_MAX_GRAPH_BYTES"))
+        text = text.decode("utf-8")
+    except TooLargeError as exc:
+        raise FormatError(f"{path}: graph {exc}") from exc
     except (OSError, UnicodeDecodeError) as exc:
-        raise FormatError(f"{path}: cannot read graph file: {exc}") from exc
+        why = exc.strerror if isinstance(exc, OSError) else f"not UTF-8 text ({exc.reason})"
+        raise FormatError(f"{path}: cannot read graph file: {why or exc}") from exc
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise FormatError(f"{path}: not valid JSON: {exc}") from exc
+    except RecursionError:
+        raise FormatError(f"{path}: not a graph file: JSON nested too deeply") from None
     try:
         pop, root = graph_from_dict(data)
-    except FormatError as exc:
+        check_depth(data["meta"])
+    except (FormatError, ValueError) as exc:
         raise FormatError(f"{path}: {exc}") from exc
     return pop, root, data["meta"]

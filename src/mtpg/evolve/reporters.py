@@ -1,0 +1,247 @@
+"""The generation loop and its observers ("reporters"), in the spirit of neat-python's.
+
+:func:`generations` yields the trainer's completed generations; :func:`train` hands each
+one to every reporter, in order. Metrics rows, test results, champions and checkpoints
+are reporters, and so is the progress display: the library trains without any run
+directory when given none, e.g. ``train(Trainer(config), [CallbackReporter(print_row)])``.
+
+A generation is a transaction. Reporters see it only once it is complete (varied,
+evaluated, selected and, at a test point, tested), and :meth:`Reporter.end` runs only
+after a complete generation, when the run is done or asked to stop: never from a
+``finally`` with a generation half made. The run directory's commit is the checkpoint
+(:class:`CheckpointReporter`): champion files, then the checkpoint file, written
+atomically; rows and test files of later generations are rolled back on resume (see
+:mod:`mtpg.evolve.session`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mtpg.evolve.persist import state_to_payload
+from mtpg.evolve.trainer import Trainer, metric_columns, test_columns
+from mtpg.io.checkpoint import checkpoint_path, prune_checkpoints, save_checkpoint
+from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, MetricsWriter, champion_filename, write_champions
+from mtpg.io.serialize import save_graph
+from mtpg.testhook import point
+
+__all__ = [
+    "TESTS_DIR",
+    "TESTS_FILE",
+    "CallbackReporter",
+    "CheckpointReporter",
+    "Generation",
+    "MetricsReporter",
+    "Reporter",
+    "TestsReporter",
+    "champion_graphs",
+    "generations",
+    "train",
+    "write_test_graphs",
+]
+
+
+@dataclass(frozen=True)
+class Generation:
+    """One completed generation.
+
+    Attributes:
+        number: The generation (1-based).
+        metrics: Its ``metrics.csv`` row (``metric_columns`` keys).
+        tests: Its ``tests.csv`` rows when it was a test point, else None.
+    """
+
+    number: int
+    metrics: dict[str, float]
+    tests: list[dict[str, Any]] | None
+
+
+class Reporter:
+    """Observer of a training run; every method does nothing unless overridden."""
+
+    def start(self, trainer: Trainer) -> None:
+        """Called once before the first generation."""
+
+    def generation(self, gen: Generation, trainer: Trainer) -> None:
+        """Called after each completed generation, in reporter order."""
+
+    def end(self, trainer: Trainer) -> None:
+        """Called when the run is done or stopped at a generation boundary."""
+
+
+class CallbackReporter(Reporter):
+    """Calls ``fn(metrics_row, trainer)`` after each generation (e.g. a progress display)."""
+
+    def __init__(self, fn: Callable[[dict[str, float], Trainer], None]) -> None:
+        self.fn = fn
+
+    def generation(self, gen: Generation, trainer: Trainer) -> None:
+        """Calls the function."""
+        self.fn(gen.metrics, trainer)
+
+
+def generations(
+    trainer: Trainer, should_stop: Callable[[], bool] | None = None
+) -> Iterator[Generation]:
+    """Runs generations until the trainer is done or ``should_stop()`` says so.
+
+    ``should_stop`` is asked before each generation, so a stop request is honoured at
+    the next generation boundary. Test points are tested (their time enters ``t_test``
+    and ``t_total``) before the generation is yielded.
+    """
+    while not trainer.done and not (should_stop and should_stop()):
+        row = trainer.run_generation()
+        tests = None
+        if trainer.test_due():
+            start = time.perf_counter()
+            tests = trainer.test_champions()
+            row["t_test"] = time.perf_counter() - start
+            row["t_total"] += row["t_test"]
+        yield Generation(trainer.state.generation, row, tests)
+
+
+def train(
+    trainer: Trainer,
+    reporters: Sequence[Reporter] = (),
+    should_stop: Callable[[], bool] | None = None,
+) -> bool:
+    """Runs the remaining generations, reporting each.
+
+    Args:
+        trainer: The trainer (fresh or restored).
+        reporters: Observers, called in this order.
+        should_stop: Asked before each generation; True stops the run there.
+
+    Returns:
+        True when every configured generation has run, False when stopped early.
+        An exception raised by a generation or a reporter propagates without
+        :meth:`Reporter.end` being called.
+    """
+    for r in reporters:
+        r.start(trainer)
+    for gen in generations(trainer, should_stop):
+        for r in reporters:
+            r.generation(gen, trainer)
+    for r in reporters:
+        r.end(trainer)
+    return trainer.done
+
+
+class MetricsReporter(Reporter):
+    """Appends each generation's row to ``metrics.csv``."""
+
+    def __init__(self, path: Path, tasks: tuple[str, ...]) -> None:
+        self.writer = MetricsWriter(path, metric_columns(tasks))
+
+    def generation(self, gen: Generation, trainer: Trainer) -> None:
+        """Appends the row."""
+        self.writer.append(gen.metrics)
+        point("metrics", gen.number)
+
+    def close(self) -> None:
+        """Closes the file."""
+        self.writer.close()
+
+
+class TestsReporter(Reporter):
+    """Writes each test point's rows to ``tests.csv`` and champion graphs to ``tests/``.
+
+    The graphs of the full-set and single-task champions go to
+    ``tests/gen-NNNNNN/<subset>.json``.
+    """
+
+    __test__ = False  # not a pytest test class
+
+    def __init__(self, run_path: Path, tasks: tuple[str, ...]) -> None:
+        self.run_path = run_path
+        self.writer = MetricsWriter(run_path / TESTS_FILE, test_columns(tasks))
+
+    def generation(self, gen: Generation, trainer: Trainer) -> None:
+        """Writes the rows and graphs of a test point."""
+        if gen.tests is None:
+            return
+        for row in gen.tests:
+            self.writer.append(row)
+        point("test", gen.number)
+        write_test_graphs(self.run_path, trainer, gen.tests)
+
+    def close(self) -> None:
+        """Closes the file."""
+        self.writer.close()
+
+
+def write_test_graphs(run_path: Path, trainer: Trainer, rows: list[dict[str, Any]]) -> None:
+    """Writes the graphs of the tested full-set and single-task champions."""
+    state, cfg = trainer.state, trainer.config
+    tasks = cfg.evaluation.tasks
+    folder = run_path / TESTS_DIR / f"gen-{state.generation:06d}"
+    for k, row in enumerate(rows):
+        names = trainer.subset_names(k)
+        if len(names) not in (1, len(tasks)):
+            continue
+        meta = {
+            "generation": state.generation,
+            "seed": cfg.seed,
+            "test": {t: row[f"test_{t}"] for t in tasks},
+            "test_episodes": cfg.evaluation.test_episodes,
+            "no_memory": cfg.evaluation.no_memory,
+        }
+        folder.mkdir(parents=True, exist_ok=True)
+        save_graph(folder / champion_filename(names), state.population, int(row["root"]), meta)
+
+
+def champion_graphs(trainer: Trainer) -> dict[tuple[str, ...], tuple[Any, int, dict[str, Any]]]:
+    """The champion of every task subset with its meta, as ``write_champions`` takes them."""
+    state, cfg = trainer.state, trainer.config
+    out = {}
+    for k, root in enumerate(state.champions):
+        names = trainer.subset_names(k)
+        scores = state.scores[root]
+        meta = {
+            "generation": state.generation,
+            "seed": cfg.seed,
+            "train_scores": {t: float(scores[cfg.evaluation.tasks.index(t)]) for t in names},
+            "no_memory": cfg.evaluation.no_memory,
+        }
+        out[names] = (state.population, root, meta)
+    return out
+
+
+class CheckpointReporter(Reporter):
+    """Commits the run every ``interval`` generations and at the end.
+
+    A commit writes the champion files, then the checkpoint (atomically: its rename is
+    the commit point), then prunes older checkpoints.
+    """
+
+    def __init__(self, run_path: Path, interval: int, saved_generation: int) -> None:
+        self.run_path = run_path
+        self.interval = interval
+        self.saved_generation = saved_generation
+
+    def generation(self, gen: Generation, trainer: Trainer) -> None:
+        """Commits when the generation is on the interval."""
+        if gen.number % self.interval == 0:
+            self.commit(trainer)
+
+    def end(self, trainer: Trainer) -> None:
+        """Commits the last generation unless already committed."""
+        if trainer.state.generation != self.saved_generation:
+            self.commit(trainer)
+
+    def commit(self, trainer: Trainer) -> Path:
+        """Writes champions and checkpoint of the current (complete) generation."""
+        state = trainer.state
+        gen = state.generation
+        write_champions(self.run_path, champion_graphs(trainer))
+        point("commit", gen)
+        path = checkpoint_path(self.run_path, gen)
+        save_checkpoint(path, state_to_payload(state), lambda: point("checkpoint", gen))
+        point("committed", gen)
+        prune_checkpoints(self.run_path, keep=2)
+        self.saved_generation = gen
+        return path

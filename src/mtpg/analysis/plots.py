@@ -37,7 +37,9 @@ def pyplot():
 
 def finish(fig, path: Path, caption: str, legend_rows: int = 0) -> Path:
     """Adds the caption (what is shown, how chosen) under the axes and saves the figure."""
-    text = "\n".join(textwrap.wrap(caption, width=int(fig.get_figwidth() * 15)))
+    text = "\n".join(
+        textwrap.wrap(caption, width=int(fig.get_figwidth() * 15), break_on_hyphens=False)
+    )
     lines = text.count("\n") + 1
     bottom = (0.16 * lines + 0.28 * legend_rows + 0.1) / fig.get_figheight()
     fig.text(0.01, 0.01, text, fontsize=7, va="bottom", ha="left", color="0.25")

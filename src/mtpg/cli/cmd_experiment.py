@@ -58,6 +58,10 @@ def run(args: argparse.Namespace) -> int:
     workers = max(1, config.workers // args.parallel)
     folder = Path(args.out)
     runs = plan(folder, args.seeds, args.ablation_seeds)
+    from mtpg.cli.progress import ExperimentProgress
+
+    watch = ExperimentProgress(runs, config.generations, lambda m: print(m, file=sys.stderr))
+    watch.start()
     failed = execute(
         runs,
         train_args,
@@ -66,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         workers,
         log=lambda m: print(m, file=sys.stderr),
     )
+    watch.stop()
     if failed:
         names = ", ".join(r.path.name for r in failed)
         print(

@@ -101,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
         f" of {cfg.generations}; tasks: {', '.join(cfg.evaluation.tasks)})",
         file=sys.stderr,
     )
-    progress = None if args.quiet else Progress(cfg.generations, cfg.evaluation.tasks)
+    progress = None if args.quiet else Progress.for_session(session)
     signal.signal(signal.SIGTERM, _terminate)
     try:
         session.run_all(progress)

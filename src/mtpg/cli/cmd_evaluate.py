@@ -74,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
 
     pop, root, meta, tasks = resolve_graph(Path(args.target))
     if args.episodes is None:  # a run's own protocol, so evaluate and report agree
-        args.episodes = int(meta.get("test_episodes", N_TEST_EPISODES))
+        is_run = Path(args.target).is_dir()
+        args.episodes = int(meta["test_episodes"]) if is_run else N_TEST_EPISODES
     if args.episodes < 1:
         raise UsageError(f"--episodes must be >= 1, got {args.episodes}")
     if args.tasks:

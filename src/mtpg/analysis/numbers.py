@@ -18,7 +18,8 @@ For each run:
   when that champion does no better than random play.
 - **Best run** of a group (the black line of Figs. 3-4, the bars of Figs. 5-6): the run
   whose all-task champion has the highest minimum over tasks of its reference-normalised
-  *training* score, so no test result decides which run is shown as best.
+  *training* score (ties, e.g. a task no run has learnt, broken by the highest mean), so no
+  test result decides which run is shown as best.
 
 Every figure prints these choices (champion, generation, episodes, denominator).
 """
@@ -40,7 +41,7 @@ CHAMPION_RULE = "champion = best root by training score at the final generation"
 #: How the best run is chosen, in words.
 BEST_RUN_RULE = (
     "Best run = highest minimum (over tasks) reference-normalised training score of its "
-    "all-task champion"
+    "all-task champion, ties broken by the highest mean"
 )
 #: The single-task denominator, in words.
 SINGLE_RULE = (
@@ -83,9 +84,10 @@ class RunNumbers:
         return self.run.test_episodes
 
     @property
-    def selection_score(self) -> float:
-        """What the best run is chosen by: the minimum reference-normalised training score."""
-        return float(min(self.train_normalised.values()))
+    def selection_score(self) -> tuple[float, float]:
+        """The best run's key: min, then mean, of the normalised training scores."""
+        values = list(self.train_normalised.values())
+        return float(min(values)), float(np.mean(values))
 
 
 def champion_path(run: RunData, subset: tuple[str, ...] | None = None) -> Path:

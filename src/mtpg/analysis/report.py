@@ -74,8 +74,9 @@ def _runs_list(groups: list[RunGroup], numbers: dict[Path, RunNumbers]) -> str:
             items.append(
                 f"<li>{html.escape(str(r.path))}: {html.escape(g.label)}, seed {r.config.seed}, "
                 f"final generation {n.generation}, {n.episodes} test episodes per task, "
-                f"all-task champion root {n.root} ({n.graph_teams} teams), minimum normalised "
-                f"training score {n.selection_score:.3f}{mark}</li>"
+                f"all-task champion root {n.root} ({n.graph_teams} team"
+                f"{'s' if n.graph_teams != 1 else ''}), normalised training score: minimum "
+                f"{n.selection_score[0]:.3f}, mean {n.selection_score[1]:.3f}{mark}</li>"
             )
     return "<ul>" + "".join(items) + "</ul>"
 

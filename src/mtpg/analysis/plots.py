@@ -141,7 +141,8 @@ def normalised_vs_single(group: RunGroup, numbers: Numbers, path: Path) -> Path:
     for k, n in enumerate(sorted(runs, key=lambda n: n is best)):
         is_best = n is best
         ys = np.array([n.vs_single[t] for t in tasks])
-        shift = 0.0 if is_best else 0.04 * (k - (len(runs) - 1) / 2)  # overlapping runs show
+        # other runs drawn slightly left of the best run, so equal scores stay visible
+        shift = 0.0 if is_best else -(k + 1) * min(0.04, 0.3 / len(runs))
         ax.plot(
             np.arange(len(tasks)) + shift,
             ys,

@@ -222,7 +222,7 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
         )
     fig, ax = plt.subplots(figsize=(8.5, 5))
     _bars(ax, tasks, bars)
-    ax.set_ylabel(f"normalised test score\n(0 = random, 1 = {ref.run.name}'s single-task)")
+    ax.set_ylabel(f"normalised test score\n(0 = random, 1 = single-task, {ref.run.name})")
     ax.set_title("Experiments: the best run's all-task champion of each")
     ax.legend(fontsize=7)
     caption = (

@@ -122,7 +122,7 @@ def test_report_evaluate_and_html_agree_on_every_number(runs, report, capsys):
             assert row["normalised"] == n.normalised[task]
             vs = row["normalised_single_task"]
             assert (vs is None and np.isnan(n.vs_single[task])) or vs == n.vs_single[task]
-            assert row["best_single_task"] == n.single[task]
+            assert row["single_task_champion"] == n.single[task]
             assert test_rows[run.name][k] == f"{n.test[task]:.3f}"
             assert norm_rows[run.name][k] == f"{n.normalised[task]:.3f}"
             expect = "n/a" if np.isnan(n.vs_single[task]) else f"{n.vs_single[task]:.3f}"

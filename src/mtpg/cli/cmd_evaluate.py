@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
     single = single_task_bests(Path(args.target), tasks)
     out = {t: s.as_dict() for t, s in scores.items()}
     for t, best in single.items():
-        out[t]["best_single_task"] = best
+        out[t]["single_task_champion"] = best
         out[t]["normalised_single_task"] = normalise_scores({t: scores[t].mean}, {t: best})[t]
     if args.json:  # strict JSON: an undefined ratio (best = random) is null
         clean = {

@@ -41,7 +41,10 @@ def finish(fig, path: Path, caption: str, legend_rows: int = 0) -> Path:
         textwrap.wrap(caption, width=int(fig.get_figwidth() * 15), break_on_hyphens=False)
     )
     lines = text.count("\n") + 1
-    bottom = (0.16 * lines + 0.28 * legend_rows + 0.1) / fig.get_figheight()
+    caption_top = (0.16 * lines + 0.1) / fig.get_figheight()
+    for legend in fig.legends:  # a figure legend sits between the plots and the caption
+        legend.set_bbox_to_anchor((0.5, caption_top), transform=fig.transFigure)
+    bottom = caption_top + 0.3 * legend_rows / fig.get_figheight()
     fig.text(0.01, 0.01, text, fontsize=7, va="bottom", ha="left", color="0.25")
     fig.tight_layout(rect=(0, bottom, 1, 1))
     fig.savefig(path, dpi=110)
@@ -80,7 +83,15 @@ def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
                 color="black" if is_best else "0.65",
                 lw=2 if is_best else 1,
                 marker="." if len(x) < 30 else None,
-                label=f"all-task champion, best run ({run.name})" if is_best else None,
+                label=(
+                    (
+                        f"all-task champion, best run ({run.name})"
+                        if len(runs) > 1
+                        else f"all-task champion ({run.name})"
+                    )
+                    if is_best
+                    else None
+                ),
             )
         single = [run.curve(task, task) for run in runs]
         n = min(len(x) for x, _ in single)
@@ -96,23 +107,16 @@ def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
     for ax in list(axes.flat)[len(tasks) :]:
         ax.axis("off")
     handles, labels = axes.flat[0].get_legend_handles_labels()
-    fig.legend(
-        handles,
-        labels,
-        loc="lower center",
-        ncol=3,
-        fontsize=8,
-        frameon=False,
-        bbox_to_anchor=(0.5, 0.55 / fig.get_figheight() + 0.02),
-    )
-    fig.suptitle(f"Learning curves: {group.label}, {len(runs)} run(s)")
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, frameon=False)
+    fig.suptitle(f"Learning curves: {group.label}, {len(runs)} run{'s' if len(runs) > 1 else ''}")
     cfg = runs[0].config.evaluation
     caption = (
         f"Test return = mean over {describe_held_out(cfg.test_episodes)}, at every "
         f"{cfg.test_interval} generations and the last. At each test point every champion is "
-        f"the best root by training score ({cfg.train_episodes} training episodes per task). "
-        f"Black: {BEST_RUN_RULE} at the final generation."
+        f"the best root by training score ({cfg.train_episodes} training episodes per task)."
     )
+    if len(runs) > 1:
+        caption += f" Black: {BEST_RUN_RULE}, at the final generation."
     return finish(fig, path, caption, legend_rows=1)
 
 

@@ -1,3 +1,5 @@
+import json
+import re
 import shutil
 import subprocess
 import warnings
@@ -5,12 +7,14 @@ import warnings
 import numpy as np
 import pytest
 
-from mtpg.analysis import plots
-from mtpg.analysis.report import build_report
-from mtpg.analysis.runs import load_run, normalise_scores, reference_best, vs_single_task
+from mtpg.analysis import plots, plots_stats
+from mtpg.analysis.numbers import best_of, champion_path, run_numbers
+from mtpg.analysis.report import MixedRunsWarning, build_report
+from mtpg.analysis.runs import group_runs, load_run, normalise_scores, reference_best
 from mtpg.cli.main import main
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
 from mtpg.envs.reference import REFERENCE, measure_random, measure_time_optimal_cartcentering
+from mtpg.io.serialize import load_graph
 from tinyruns import tiny_args
 
 TINY = [
@@ -30,53 +34,172 @@ def runs(tmp_path_factory):
     return dirs
 
 
-def test_report_writes_every_figure_without_warnings(runs, tmp_path):
+@pytest.fixture(scope="module")
+def twelve(tmp_path_factory):
+    """A 12-generation run tested every 5 generations."""
+    out = tmp_path_factory.mktemp("long") / "g12"
+    args = tiny_args(n_elite=3, evaluation__test_interval=5, evaluation__test_episodes=3)
+    assert main(["train", *args, "--generations", "12", "--out", str(out)]) == 0
+    return out
+
+
+def test_a_test_point_at_the_last_generation(twelve):
+    run = load_run(twelve)
+    assert sorted({int(r["generation"]) for r in run.tests}) == [5, 10, 12]
+    assert run_numbers(run).generation == 12
+    assert champion_path(run).parent.name == "gen-000012"
+
+
+EXPECTED = [
+    "ablations.png",
+    "aggregate.png",
+    "hierarchy.png",
+    "learning_curves.png",
+    "normalised_vs_reference.png",
+    "normalised_vs_single.png",
+    "performance_profile.png",
+]
+
+
+@pytest.fixture(scope="module")
+def report(runs, tmp_path_factory):
+    """The report of the three runs (two seeds and an ablation), built once."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        index = build_report(runs, tmp_path / "report")
-    names = sorted(p.name for p in (tmp_path / "report").glob("*.png"))
-    assert names == [
-        "ablations.png",
-        "hierarchy.png",
-        "learning_curves.png",
-        "normalised_vs_reference.png",
-        "normalised_vs_single.png",
-    ]
-    page = index.read_text()
-    assert page.count("<img ") == 5 and "data:image/png;base64," in page
+        return build_report(runs, tmp_path_factory.mktemp("report") / "report")
+
+
+def test_report_writes_every_figure_without_warnings(report):
+    names = sorted(p.name for p in report.parent.glob("*.png"))
+    assert names == EXPECTED
+    page = report.read_text()
+    assert page.count("<img ") == len(EXPECTED) and "data:image/png;base64," in page
     for png in names:
-        assert (tmp_path / "report" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert (report.parent / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_default_report_location(runs, capsys):
+@pytest.fixture
+def quick_png(monkeypatch):
+    """Figures saved as stub files (rendering is tested once, by the ``report`` fixture)."""
+    import matplotlib.figure
+
+    monkeypatch.setattr(
+        matplotlib.figure.Figure, "savefig", lambda self, path, **kw: path.write_bytes(b"png")
+    )
+
+
+def test_default_report_location(runs, capsys, quick_png):
     assert main(["report", str(runs[0])]) == 0
     assert (runs[0] / "report" / "index.html").is_file()
     assert not (runs[0] / "report" / "ablations.png").exists()  # one experiment only
 
 
-@pytest.mark.parametrize(
-    "draw",
-    [
-        plots.learning_curves,
-        plots.normalised_vs_single,
-        plots.normalised_vs_reference,
-        plots.ablations,
-        plots.hierarchy,
-    ],
-)
-def test_every_figure_has_labelled_axes_and_a_legend(runs, tmp_path, monkeypatch, draw):
+def _cells(page: str, title: str) -> dict[str, list[str]]:
+    """Rows of the HTML table under ``title``: run name -> cell texts."""
+    table = page.split(f"<h2>{title}</h2>", 1)[1].split("</table>", 1)[0]
+    rows = {}
+    for tr in re.findall(r"<tr>(.*?)</tr>", table)[1:]:
+        cells = re.findall(r"<td>(.*?)</td>", tr)
+        rows[cells[1]] = cells[2:]
+    return rows
+
+
+def test_report_evaluate_and_html_agree_on_every_number(runs, report, capsys):
+    page = report.read_text()
+    test_rows = _cells(page, "Test return of each run&#x27;s all-task champion")
+    norm_rows = _cells(page, "Normalised against the reference best")
+    single_rows = _cells(page, "Normalised against the run&#x27;s own single-task champions")
+    for path in runs:
+        run = load_run(path)
+        n = run_numbers(run)
+        capsys.readouterr()
+        assert main(["evaluate", str(path), "--json"]) == 0
+        data = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+        for k, task in enumerate(run.tasks):
+            row = data[task]
+            assert row["episodes"] == n.episodes == 3  # the run's own test episodes
+            assert row["mean"] == n.test[task]  # same graph, same episodes: bit for bit
+            assert row["normalised"] == n.normalised[task]
+            vs = row["normalised_single_task"]
+            assert (vs is None and np.isnan(n.vs_single[task])) or vs == n.vs_single[task]
+            assert row["single_task_champion"] == n.single[task]
+            assert test_rows[run.name][k] == f"{n.test[task]:.3f}"
+            assert norm_rows[run.name][k] == f"{n.normalised[task]:.3f}"
+            expect = "n/a" if np.isnan(n.vs_single[task]) else f"{n.vs_single[task]:.3f}"
+            assert single_rows[run.name][k] == expect
+        assert f"final generation {n.generation}, 3 test episodes per task" in page
+
+
+def test_numbers_use_training_selection_not_test_scores(runs):
+    run = load_run(runs[0])
+    n = run_numbers(run)
+    final = run.final_generation
+    # the single-task denominators are the single-task champions at the final generation,
+    # whatever their earlier test scores
+    for task in run.tasks:
+        assert n.single[task] == float(run.row(task, final)[f"test_{task}"])
+    # training scores are recomputed from the graph and equal what selection used
+    _, _, meta = load_graph(runs[0] / "champions" / "CartPole+CartCentering.json")
+    assert meta["generation"] == final
+    assert n.train == pytest.approx(meta["train_scores"], abs=0)
+    # the best run is the one with the highest minimum normalised training score
+    all_n = [run_numbers(load_run(p)) for p in runs[:2]]
+    assert best_of(all_n).selection_score == max(x.selection_score for x in all_n)
+
+
+def test_mixed_configurations_are_grouped_labelled_and_warned(
+    runs, twelve, tmp_path, capsys, quick_png
+):
+    loaded = [load_run(p) for p in [*runs, twelve]]
+    groups, warns = group_runs(loaded)
+    labels = [g.label for g in groups]
+    assert [len(g.runs) for g in groups] == [2, 1, 1]
+    assert labels[0].startswith("TPG (") and "generations=4" in labels[0]
+    assert "generations=12" in labels[1] and labels[2] == "TPG-NoMemory"
+    assert any("generations" in w for w in warns) and any("test_interval" in w for w in warns)
+    # seeds and an ablation alone are not a mixture
+    assert group_runs(loaded[:3])[1] == []
+    assert main(["report", *map(str, runs), str(twelve), "--out", str(tmp_path / "m2")]) == 0
+    err = capsys.readouterr().err
+    assert "warning: runs differ in generations" in err
+    assert "Warning: runs differ" in (tmp_path / "m2" / "index.html").read_text()
+
+
+FIGURES = [
+    lambda g, n, p: plots.learning_curves(g[0], n, p),
+    lambda g, n, p: plots.normalised_vs_single(g[0], n, p),
+    lambda g, n, p: plots.normalised_vs_reference(g[0], n, p),
+    lambda g, n, p: plots.ablations(g, n, p),
+    lambda g, n, p: plots.hierarchy(g[0], n, p),
+    lambda g, n, p: plots_stats.aggregate(
+        g, n, {x.label: plots_stats.group_estimates(x, n) for x in g}, p
+    ),
+    lambda g, n, p: plots_stats.profile(g, n, p),
+]
+
+
+@pytest.mark.parametrize("draw", FIGURES)
+def test_every_figure_is_labelled_and_states_its_numbers(runs, tmp_path, monkeypatch, draw):
     figs = []
+    import matplotlib.figure
     import matplotlib.pyplot as plt
 
-    monkeypatch.setattr(plots, "_save", lambda fig, path: figs.append(fig) or path)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda *a, **k: None)  # fast
     monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig) if fig else None)
-    draw([load_run(p) for p in runs], tmp_path / "x.png")
+    loaded = [load_run(p) for p in runs]
+    groups, _ = group_runs(loaded)
+    numbers = {r.path: run_numbers(r) for r in loaded}
+    draw(groups, numbers, tmp_path / "x.png")
     fig = figs[0]
     used = [ax for ax in fig.axes if ax.axison]
     assert used
     for ax in used:
-        assert ax.get_xlabel() and ax.get_ylabel() and ax.get_title()
+        assert ax.get_xlabel() and ax.get_ylabel() and (ax.get_title() or fig._suptitle)
         assert ax.get_legend() is not None or fig.legends
+    caption = " ".join(t.get_text() for t in fig.texts).replace("\n", " ")
+    assert "held-out episodes" in caption and "3 held-out" in caption  # how many episodes
+    assert "training score" in caption  # the selection rule
+    assert "generation" in caption  # at which generation
 
 
 def test_normalisation_is_0_for_random_and_1_for_the_reference_controller():
@@ -92,20 +215,18 @@ def test_normalisation_is_0_for_random_and_1_for_the_reference_controller():
     assert abs(normalise_scores({task: mean}, ref)[task]) < 0.05
 
 
-def test_multitask_normalised_by_single_task_champions(runs):
-    run = load_run(runs[0])
-    norm = vs_single_task(run)
-    for task in run.tasks:
-        if np.isfinite(norm[task]) and run.best_single(task) == run.multitask_scores()[task]:
-            assert norm[task] == pytest.approx(1.0)
+def test_mixture_warning_is_a_python_warning(runs, twelve, monkeypatch, tmp_path):
+    monkeypatch.setattr("mtpg.analysis.report.run_numbers", lambda run: 1 / 0)
+    with pytest.warns(MixedRunsWarning), pytest.raises(ZeroDivisionError):
+        build_report([runs[0], twelve], tmp_path / "x")  # warned before any number is made
 
 
 @pytest.mark.skipif(
     not (shutil.which("chromium") or shutil.which("chromium-browser")),
     reason="Chromium is not installed",
 )
-def test_report_page_opens_in_headless_chromium(runs, tmp_path):
-    index = build_report(runs, tmp_path / "report")
+def test_report_page_opens_in_headless_chromium(report, tmp_path):
+    index = report
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
     shot = tmp_path / "page.png"
     res = subprocess.run(
@@ -130,14 +251,3 @@ def test_report_page_opens_in_headless_chromium(runs, tmp_path):
     )
     assert res.returncode == 0, res.stderr
     assert shot.is_file() and shot.stat().st_size > 10_000
-
-
-def test_evaluate_run_reports_both_normalisations(runs, capsys):
-    import json
-
-    assert main(["evaluate", str(runs[0]), "--episodes", "3", "--json"]) == 0
-    data = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
-    run = load_run(runs[0])
-    for task, row in data.items():
-        assert row["best_single_task"] == run.best_single(task)
-        assert "normalised_single_task" in row and "normalised" in row

@@ -18,8 +18,8 @@ from mtpg.engine.stepper import play_episode, production_steps
 from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE, TASK_NAMES
+from mtpg.envs.protocol import held_out_seeds
 from mtpg.evolve.trainer import Trainer
-from mtpg.evolve.trainer import test_seeds as held_out_seeds
 from mtpg.model.graph import check_invariants
 
 EXTREME = [0.0, 1.0, -1.0, 1e-300, -1e-300, 1e10, -1e10, 1e300, -1e300, 0.5]

@@ -9,8 +9,8 @@ import numpy as np
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.protocol import held_out_seeds
 from mtpg.envs.reference import REFERENCE, normalise
-from mtpg.evolve.trainer import test_seeds
 from mtpg.model.graph import Population
 
 
@@ -65,7 +65,7 @@ def evaluate_graph(
         root: The root team id.
         tasks: Task names.
         episodes: Episodes per task.
-        seed: Offset of the test seeds (see :func:`mtpg.evolve.trainer.test_seeds`).
+        seed: Offset of the test seeds (see :func:`mtpg.envs.protocol.held_out_seeds`).
         workers: Threads.
         no_memory: Evaluate with the no-memory ablation semantics.
 
@@ -73,7 +73,7 @@ def evaluate_graph(
         Scores by task name, in the order given.
     """
     ids = [TASK_NAMES.index(t) for t in tasks]
-    table = Episodes.grid(ids, test_seeds(episodes, seed))
+    table = Episodes.grid(ids, held_out_seeds(episodes, seed))
     returns, result = evaluate_roots(compile_population(pop), [root], table, workers, no_memory)
     returns = returns.reshape(len(ids), episodes)
     steps = result.steps.reshape(len(ids), episodes)

@@ -13,8 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.evolve.session import TESTS_FILE
-from mtpg.io.rundir import METRICS_FILE
+from mtpg.io.rundir import METRICS_FILE, TESTS_FILE
 
 
 def _read(path: Path) -> list[dict[str, str]]:

@@ -1,21 +1,32 @@
-"""The figures of paper section 5 from run directories (matplotlib, imported lazily)."""
+"""The figures of paper section 5 from run directories (matplotlib, Agg backend).
+
+Every figure states under its plot which champion it shows (selected on training scores,
+at which generation), on how many held-out episodes, and what 0 and 1 mean
+(:mod:`mtpg.analysis.numbers`).
+"""
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.runs import (
-    RunData,
-    best_run,
-    normalise_scores,
-    reference_best,
-    vs_single_task,
+from mtpg.analysis.numbers import (
+    BEST_RUN_RULE,
+    SINGLE_RULE,
+    RunNumbers,
+    best_of,
+    describe,
 )
+from mtpg.analysis.runs import RunGroup, normalise_scores, reference_best
+from mtpg.envs.protocol import describe_held_out
+
+Numbers = dict[Path, RunNumbers]  # run directory -> its numbers
 
 
-def _pyplot():
+def pyplot():
+    """The pyplot module of matplotlib on the file-only Agg backend."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -24,33 +35,46 @@ def _pyplot():
     return plt
 
 
-def main_runs(runs: list[RunData]) -> list[RunData]:
-    """The runs of the full algorithm (ablation runs have their own figure)."""
-    return [r for r in runs if r.label == "TPG"] or runs
-
-
-def _save(fig, path: Path) -> Path:
-    fig.tight_layout()
+def finish(fig, path: Path, caption: str, legend_rows: int = 0) -> Path:
+    """Adds the caption (what is shown, how chosen) under the axes and saves the figure."""
+    text = "\n".join(
+        textwrap.wrap(caption, width=int(fig.get_figwidth() * 15), break_on_hyphens=False)
+    )
+    lines = text.count("\n") + 1
+    caption_top = (0.16 * lines + 0.1) / fig.get_figheight()
+    for legend in fig.legends:  # a figure legend sits between the plots and the caption
+        legend.set_bbox_to_anchor((0.5, caption_top), transform=fig.transFigure)
+    bottom = caption_top + 0.3 * legend_rows / fig.get_figheight()
+    fig.text(0.01, 0.01, text, fontsize=7, va="bottom", ha="left", color="0.25")
+    fig.tight_layout(rect=(0, bottom, 1, 1))
     fig.savefig(path, dpi=110)
-    _pyplot().close(fig)
+    pyplot().close(fig)
     return path
 
 
-def learning_curves(runs: list[RunData], path: Path) -> Path:
-    """Fig. 3: test return per task over generations.
+def _task_axis(ax, tasks: tuple[str, ...]) -> None:
+    ax.set_xticks(range(len(tasks)))
+    ax.set_xticklabels(tasks, rotation=20, ha="right")
+    ax.set_xlabel("task")
+    ax.axhline(0, color="0.5", lw=0.8, ls="--")
+    ax.axhline(1, color="0.5", lw=0.8, ls=":")
 
-    Solid grey: the multi-task champion of each run; black: the best run; dotted: the
-    median over runs of the single-task champion of that task.
+
+def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
+    """Fig. 3: test return per task over generations, every run of one group.
+
+    Grey: the all-task champion of each run at each test point; black: the best run;
+    dotted: the median over runs of the single-task champion of that task.
     """
-    runs = main_runs(runs)
-    plt = _pyplot()
+    plt = pyplot()
+    runs = group.runs
     tasks = runs[0].tasks
-    best = best_run(runs)
+    best = best_of([numbers[r.path] for r in runs]).run
     cols = min(3, len(tasks))
     rows = -(-len(tasks) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.2 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.3 * cols, 3.2 * rows + 1.3), squeeze=False)
     for ax, task in zip(axes.flat, tasks, strict=False):
-        for run in runs:
+        for run in sorted(runs, key=lambda r: r is best):
             x, y = run.curve(run.full_set, task)
             is_best = run is best
             ax.plot(
@@ -58,22 +82,25 @@ def learning_curves(runs: list[RunData], path: Path) -> Path:
                 y,
                 color="black" if is_best else "0.65",
                 lw=2 if is_best else 1,
-                label=f"multi-task, best run ({run.path.name})" if is_best else None,
+                marker="." if len(x) < 30 else None,
+                label=(
+                    (
+                        f"all-task champion, best run ({run.name})"
+                        if len(runs) > 1
+                        else f"all-task champion ({run.name})"
+                    )
+                    if is_best
+                    else None
+                ),
             )
         single = [run.curve(task, task) for run in runs]
         n = min(len(x) for x, _ in single)
         if n:
             med = np.median(np.array([y[:n] for _, y in single]), axis=0)
-            ax.plot(
-                single[0][0][:n],
-                med,
-                ":",
-                color="tab:blue",
-                lw=2,
-                label="single-task champion (median over runs)",
-            )
+            label = "single-task champion" + (" (median over runs)" if len(runs) > 1 else "")
+            ax.plot(single[0][0][:n], med, ":", color="tab:blue", lw=2, label=label)
         if len(runs) > 1:
-            ax.plot([], [], color="0.65", label="multi-task, other runs")
+            ax.plot([], [], color="0.65", label="all-task champion, other runs")
         ax.set_title(task)
         ax.set_xlabel("generation")
         ax.set_ylabel("mean test return\n(reward per episode)")
@@ -81,107 +108,174 @@ def learning_curves(runs: list[RunData], path: Path) -> Path:
         ax.axis("off")
     handles, labels = axes.flat[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=8, frameon=False)
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    fig.suptitle(f"Learning curves: {group.label}, {len(runs)} run{'s' if len(runs) > 1 else ''}")
+    cfg = runs[0].config.evaluation
+    caption = (
+        f"Test return = mean over {describe_held_out(cfg.test_episodes)}, at every "
+        f"{cfg.test_interval} generations and the last. At each test point every champion is "
+        f"the best root by training score ({cfg.train_episodes} training episodes per task)."
+    )
+    if len(runs) > 1:
+        caption += f" Black: {BEST_RUN_RULE}, at the final generation."
+    return finish(fig, path, caption, legend_rows=1)
 
 
-def _task_axis(ax, tasks: tuple[str, ...]) -> None:
-    ax.set_xticks(range(len(tasks)))
-    ax.set_xticklabels(tasks, rotation=25, ha="right")
-    ax.set_xlabel("task")
-    ax.axhline(0, color="0.5", lw=0.8, ls="--")
-    ax.axhline(1, color="0.5", lw=0.8, ls=":")
+def _value_labels(ax, xs, values, fmt="{:.2f}") -> None:
+    for x, v in zip(xs, values, strict=True):
+        text = "n/a" if not np.isfinite(v) else fmt.format(v)
+        y = 0 if not np.isfinite(v) else v
+        ax.annotate(
+            text,
+            (x, y),
+            textcoords="offset points",
+            xytext=(0, 3 if y >= 0 else -9),
+            ha="center",
+            fontsize=7,
+        )
 
 
-def normalised_vs_single(runs: list[RunData], path: Path) -> Path:
-    """Fig. 4: each run's multi-task champion normalised by its best single-task champions."""
-    runs = main_runs(runs)
-    plt = _pyplot()
-    tasks = runs[0].tasks
-    best = best_run(runs)
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for run in runs:
-        norm = vs_single_task(run)
-        is_best = run is best
+def normalised_vs_single(group: RunGroup, numbers: Numbers, path: Path) -> Path:
+    """Fig. 4: each run's all-task champion normalised by its own single-task champions."""
+    plt = pyplot()
+    runs = [numbers[r.path] for r in group.runs]
+    tasks = group.runs[0].tasks
+    best = best_of(runs)
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    undefined = False
+    for k, n in enumerate(sorted(runs, key=lambda n: n is best)):
+        is_best = n is best
+        ys = np.array([n.vs_single[t] for t in tasks])
+        # other runs drawn slightly left of the best run, so equal scores stay visible
+        shift = 0.0 if is_best else -(k + 1) * min(0.04, 0.3 / len(runs))
         ax.plot(
-            range(len(tasks)),
-            [norm[t] for t in tasks],
+            np.arange(len(tasks)) + shift,
+            ys,
             marker="o",
             color="black" if is_best else "0.65",
             lw=2 if is_best else 1,
-            label=f"{run.path.name}{' (best)' if is_best else ''}",
+            label=f"{n.run.name}{' (best run)' if is_best else ''}",
         )
+        bad = ~np.isfinite(ys)
+        if bad.any():
+            undefined = True
+            ax.plot(np.flatnonzero(bad), np.zeros(bad.sum()), "x", color="tab:red", ms=9)
+        if is_best:
+            _value_labels(ax, range(len(tasks)), ys)
+    if undefined:
+        ax.plot([], [], "x", color="tab:red", label="undefined: single-task champion = random")
     _task_axis(ax, tasks)
-    ax.set_ylabel("normalised score\n(0 = random, 1 = best single-task)")
-    ax.set_title("Multi-task champions against single-task champions")
+    ax.set_ylabel("normalised test score\n(0 = random, 1 = own single-task champion)")
+    ax.set_title(f"All-task champions against single-task champions: {group.label}")
     ax.legend(fontsize=7)
-    return _save(fig, path)
+    caption = f"{describe(runs)} Normalised: 0 = random play, {SINGLE_RULE}. {BEST_RUN_RULE}."
+    return finish(fig, path, caption)
 
 
 def _bars(ax, tasks, groups: dict[str, dict[str, float]]) -> None:
     width = 0.8 / max(len(groups), 1)
     for k, (name, values) in enumerate(groups.items()):
         xs = np.arange(len(tasks)) + (k - (len(groups) - 1) / 2) * width
-        ax.bar(xs, [values[t] for t in tasks], width, label=name)
+        ys = np.array([values[t] for t in tasks])
+        ax.bar(xs, np.where(np.isfinite(ys), ys, 0.0), width, label=name)
+        _value_labels(ax, xs, ys)
     _task_axis(ax, tasks)
 
 
-def normalised_vs_reference(runs: list[RunData], path: Path) -> Path:
-    """Fig. 5: best multi-task and single-task champions against the reference best."""
-    runs = main_runs(runs)
-    plt = _pyplot()
-    tasks = runs[0].tasks
-    ref = reference_best(tasks)
-    multi = normalise_scores(best_run(runs).multitask_scores(), ref)
-    single = normalise_scores({t: max(r.best_single(t) for r in runs) for t in tasks}, ref)
-    fig, ax = plt.subplots(figsize=(7, 4))
-    _bars(ax, tasks, {"multi-task champion (best run)": multi, "best single-task champion": single})
-    ax.set_ylabel("normalised score\n(0 = random, 1 = reference best)")
-    ax.set_title("Champions against the reference best")
+def normalised_vs_reference(group: RunGroup, numbers: Numbers, path: Path) -> Path:
+    """Fig. 5: the best run's all-task and single-task champions against the reference best."""
+    plt = pyplot()
+    best = best_of([numbers[r.path] for r in group.runs])
+    tasks = best.run.tasks
+    single = normalise_scores(best.single, reference_best(tasks))
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    _bars(
+        ax,
+        tasks,
+        {
+            f"all-task champion ({best.run.name})": best.normalised,
+            f"single-task champions ({best.run.name})": single,
+        },
+    )
+    ax.set_ylabel("normalised test score\n(0 = random, 1 = reference best)")
+    ax.set_title(f"Champions of the best run against the reference best: {group.label}")
     ax.legend(fontsize=7)
-    return _save(fig, path)
+    caption = (
+        f"{describe([best])} Single-task champions: the best root on each task alone by "
+        f"training score at the same generation, tested on its own task. {BEST_RUN_RULE}. "
+        "Reference best: `mtpg envs` (solved thresholds, leaderboard, time-optimal law)."
+    )
+    return finish(fig, path, caption)
 
 
-def ablations(runs: list[RunData], path: Path) -> Path:
-    """Fig. 6: the best multi-task champion of each experiment, side by side."""
-    plt = _pyplot()
-    tasks = runs[0].tasks
-    full = [r for r in runs if r.label == "TPG"] or runs
-    single_best = {t: max(r.best_single(t) for r in full) for t in tasks}
-    groups = {}
-    for label in sorted({r.label for r in runs}, key=lambda s: (s != "TPG", s)):
-        members = [r for r in runs if r.label == label]
-        groups[label] = normalise_scores(best_run(members).multitask_scores(), single_best)
-    fig, ax = plt.subplots(figsize=(7.5, 4))
-    _bars(ax, tasks, groups)
-    ax.set_ylabel("normalised score\n(0 = random, 1 = best single-task TPG)")
-    ax.set_title("Ablations: best multi-task champion of each experiment")
-    ax.legend(fontsize=7)
-    return _save(fig, path)
+def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
+    """Fig. 6: the best run's all-task champion of each experiment, side by side.
 
-
-def hierarchy(runs: list[RunData], path: Path) -> Path:
-    """Fig. 7: teams visited per decision by the champion of every task subset."""
-    runs = main_runs(runs)
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(8, 4))
-    for run in runs:
-        last = max(r["generation"] for r in run.tests)
-        rows = [r for r in run.tests if r["generation"] == last]
-        sizes = np.array([len(str(r["subset"]).split("+")) for r in rows])
-        jitter = (np.arange(len(rows)) % 7 - 3) * 0.04
-        ax.scatter(
-            sizes + jitter,
-            [r["teams_per_decision"] for r in rows],
-            s=18,
-            label=f"{run.path.name} (generation {int(last)})",
-            alpha=0.8,
+    Denominators: the single-task champions of the best run of the first group (the full
+    algorithm when present), so every experiment is measured against the same scores.
+    """
+    plt = pyplot()
+    ref = best_of([numbers[r.path] for r in groups[0].runs])
+    tasks = ref.run.tasks
+    bars = {}
+    shown = []
+    for g in groups:
+        best = best_of([numbers[r.path] for r in g.runs])
+        shown.append(best)
+        bars[f"{g.label} ({best.run.name}, {len(g.runs)} run(s))"] = normalise_scores(
+            best.test, ref.single
         )
-    ax.set_xlabel("number of tasks in the subset")
-    ax.set_ylabel("teams visited per decision (test)")
-    ax.set_title("Hierarchical complexity of each task subset's champion")
-    ax.set_xticks(range(1, len(runs[0].tasks) + 1))
+    fig, ax = plt.subplots(figsize=(8.5, 5))
+    _bars(ax, tasks, bars)
+    ax.set_ylabel(f"normalised test score\n(0 = random, 1 = single-task, {ref.run.name})")
+    ax.set_title("Experiments: the best run's all-task champion of each")
     ax.legend(fontsize=7)
-    return _save(fig, path)
+    caption = (
+        f"{describe(shown)} Normalised: 0 = random play, 1 = the single-task champion of "
+        f"{ref.run.name} (best run of {groups[0].label}) at generation {ref.generation}, "
+        f"selected by training score; n/a where that champion is no better than random. "
+        f"Best run of each experiment: {BEST_RUN_RULE.removeprefix('Best run = ')}."
+    )
+    return finish(fig, path, caption)
+
+
+def hierarchy(group: RunGroup, numbers: Numbers, path: Path) -> Path:
+    """Fig. 7: teams visited per decision by the champion of every task subset.
+
+    One column per subset (ordered by size); points: minimum, median and maximum over runs
+    at the final test point, as in the paper.
+    """
+    plt = pyplot()
+    runs = group.runs
+    tasks = runs[0].tasks
+    subsets = sorted(
+        {str(r["subset"]) for r in runs[0].tests},
+        key=lambda s: (s.count("+"), [tasks.index(t) for t in s.split("+")]),
+    )
+    values = np.array(
+        [
+            [float(run.row(s, numbers[run.path].generation)["teams_per_decision"]) for s in subsets]
+            for run in runs
+        ]
+    )
+    xs = np.arange(len(subsets))
+    fig, ax = plt.subplots(figsize=(max(6.0, 0.28 * len(subsets) + 3), 5))
+    ax.scatter(xs, values.max(axis=0), marker="^", color="tab:red", s=18, label="max over runs")
+    ax.scatter(
+        xs, np.median(values, axis=0), marker="o", color="black", s=18, label="median over runs"
+    )
+    ax.scatter(xs, values.min(axis=0), marker="v", color="tab:blue", s=18, label="min over runs")
+    ax.set_xticks(xs)
+    ax.set_xticklabels(
+        ["+".join(str(tasks.index(t)) for t in s.split("+")) for s in subsets],
+        rotation=90 if len(subsets) > 12 else 0,
+        fontsize=7,
+    )
+    ax.set_xlabel("task subset (" + ", ".join(f"{k} = {t}" for k, t in enumerate(tasks)) + ")")
+    ax.set_ylabel("teams visited per decision\n(mean over test steps)")
+    ax.set_title(f"Hierarchical complexity of each subset's champion: {group.label}")
+    ax.legend(fontsize=7)
+    caption = (
+        f"{describe([numbers[r.path] for r in runs]).replace('All-task c', 'Each subset c')} "
+        f"Teams per decision counted over those test episodes of every task; {len(runs)} run(s)."
+    )
+    return finish(fig, path, caption)

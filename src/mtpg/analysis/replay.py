@@ -1,7 +1,7 @@
 """Traced replays of a graph on test episodes, and their ``.npz`` file format.
 
 A replay plays the same held-out episodes as ``mtpg evaluate`` (seeds from
-:func:`mtpg.evolve.trainer.test_seeds`) with the tracing kernel, which follows exactly the
+:func:`mtpg.envs.protocol.held_out_seeds`) with the tracing kernel, which follows exactly the
 decisions of the batch kernel, so the returns are equal.
 
 ``.npz`` schema (version 1). ``N`` steps over all episodes, ``E`` episodes, teams, banks
@@ -61,7 +61,7 @@ from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs import make_episodes
 from mtpg.envs.core import TASK_NAMES
-from mtpg.evolve.trainer import test_seeds
+from mtpg.envs.protocol import held_out_seeds
 from mtpg.model.graph import Population
 
 SCHEMA_VERSION = 1
@@ -167,7 +167,7 @@ def replay_task(
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     task_id = TASK_NAMES.index(task)
     cp = compile_population(pop)
-    seeds = test_seeds(episodes, seed)
+    seeds = held_out_seeds(episodes, seed)
     starts, noise = make_episodes(np.full(episodes, task_id), seeds)
     n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
     traces = [

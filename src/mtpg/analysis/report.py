@@ -1,112 +1,205 @@
-"""``mtpg report``: the figures of section 5 as PNG files plus one self-contained HTML page."""
+"""``mtpg report``: section 5's figures and statistics across seeds, PNGs plus one HTML page.
+
+Every number comes from :mod:`mtpg.analysis.numbers` (the same definitions ``mtpg
+evaluate`` uses); runs are grouped by configuration (:func:`mtpg.analysis.runs.group_runs`)
+and a mixture of configurations beyond the ablation switches raises
+:class:`MixedRunsWarning`.
+"""
 
 from __future__ import annotations
 
 import base64
 import html
+import warnings
 from pathlib import Path
 
-from mtpg.analysis import plots
-from mtpg.analysis.runs import (
-    RunData,
-    best_run,
-    load_run,
-    normalise_scores,
-    reference_best,
-    vs_single_task,
+import numpy as np
+
+from mtpg.analysis import plots, plots_stats
+from mtpg.analysis.numbers import (
+    BEST_RUN_RULE,
+    SINGLE_RULE,
+    RunNumbers,
+    best_of,
+    describe,
+    run_numbers,
 )
-
-FIGURES = (
-    ("learning_curves.png", "Learning curves (Fig. 3)", plots.learning_curves),
-    (
-        "normalised_vs_single.png",
-        "Against single-task champions (Fig. 4)",
-        plots.normalised_vs_single,
-    ),
-    (
-        "normalised_vs_reference.png",
-        "Against the reference best (Fig. 5)",
-        plots.normalised_vs_reference,
-    ),
-    ("hierarchy.png", "Teams per decision by task subset (Fig. 7)", plots.hierarchy),
-)
+from mtpg.analysis.runs import RunData, RunGroup, group_runs, load_run, reference_best
 
 
-def _table(title: str, tasks: tuple[str, ...], rows: dict[str, dict[str, float]]) -> str:
+class MixedRunsWarning(UserWarning):
+    """The runs of a report differ in more than seeds and ablation switches."""
+
+
+def _fmt(v: float) -> str:
+    return "n/a" if not np.isfinite(v) else f"{v:.3f}"
+
+
+def _table(title: str, note: str, tasks, rows: list[tuple[str, str, dict[str, float]]]) -> str:
     head = "".join(f"<th>{html.escape(t)}</th>" for t in tasks)
     body = "".join(
-        f"<tr><td>{html.escape(name)}</td>"
-        + "".join(f"<td>{values[t]:.3f}</td>" for t in tasks)
+        f"<tr><td>{html.escape(group)}</td><td>{html.escape(name)}</td>"
+        + "".join(f"<td>{_fmt(values[t])}</td>" for t in tasks)
         + "</tr>"
-        for name, values in rows.items()
+        for group, name, values in rows
     )
-    return f"<h2>{html.escape(title)}</h2><table><tr><th></th>{head}</tr>{body}</table>"
+    return (
+        f"<h2>{html.escape(title)}</h2><p>{html.escape(note)}</p>"
+        f"<table><tr><th>experiment</th><th>run</th>{head}</tr>{body}</table>"
+    )
+
+
+def _stats_table(groups: list[RunGroup], estimates, tasks) -> str:
+    head = "".join(f"<th>{html.escape(t)}</th>" for t in (*tasks, "all tasks"))
+    body = ""
+    for g in groups:
+        per_task, overall = estimates[g.label]
+        cells = "".join(f"<td>{html.escape(e.text(3))}</td>" for e in (*per_task, overall))
+        body += f"<tr><td>{html.escape(g.label)}</td><td>{len(g.runs)}</td>{cells}</tr>"
+    return (
+        "<h2>Across seeds: IQM [95% CI] of the normalised test score</h2>"
+        f"<p>{html.escape(plots_stats.STATS_NOTE)} Normalised: 0 = random play, "
+        "1 = reference best.</p>"
+        f"<table><tr><th>experiment</th><th>runs</th>{head}</tr>{body}</table>"
+    )
+
+
+def _runs_list(groups: list[RunGroup], numbers: dict[Path, RunNumbers]) -> str:
+    items = []
+    for g in groups:
+        best = best_of([numbers[r.path] for r in g.runs])
+        for r in g.runs:
+            n = numbers[r.path]
+            mark = " <b>(best run of the experiment)</b>" if n is best else ""
+            items.append(
+                f"<li>{html.escape(str(r.path))}: {html.escape(g.label)}, seed {r.config.seed}, "
+                f"final generation {n.generation}, {n.episodes} test episodes per task, "
+                f"all-task champion root {n.root} ({n.graph_teams} team"
+                f"{'s' if n.graph_teams != 1 else ''}), normalised training score: minimum "
+                f"{n.selection_score[0]:.3f}, mean {n.selection_score[1]:.3f}{mark}</li>"
+            )
+    return "<ul>" + "".join(items) + "</ul>"
 
 
 def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> Path:
     """Writes the PNG figures and ``index.html`` for one or more runs.
 
     Args:
-        run_dirs: Run directories on the same tasks (ablation runs are recognised from
-            their configuration and get their own figure).
+        run_dirs: Run directories on the same tasks. Runs are grouped by configuration;
+            ablation runs form their own groups and get the experiments figure.
         out: Output directory (default: ``report/`` inside the first run).
 
     Returns:
         The path of ``index.html``.
+
+    Raises:
+        ValueError: If the runs are on different tasks or have no test results.
     """
     runs: list[RunData] = [load_run(p) for p in run_dirs]
     tasks = runs[0].tasks
     for run in runs:
         if run.tasks != tasks:
             raise ValueError(f"{run.path}: tasks {run.tasks} differ from {tasks}")
-        run.final(run.full_set)  # raises a clear error for a run without tests
+    groups, mixed = group_runs(runs)
+    for text in mixed:
+        warnings.warn(text, MixedRunsWarning, stacklevel=2)
+    numbers = {r.path: run_numbers(r) for r in runs}
+    estimates = {g.label: plots_stats.group_estimates(g, numbers) for g in groups}
     out = Path(out) if out is not None else runs[0].path / "report"
     out.mkdir(parents=True, exist_ok=True)
-    figures = list(FIGURES)
-    if len({r.label for r in runs}) > 1:
-        figures.insert(3, ("ablations.png", "Ablations (Fig. 6)", plots.ablations))
+    main = groups[0]
+    figures = [
+        (
+            "learning_curves.png",
+            "Learning curves (Fig. 3)",
+            lambda p: plots.learning_curves(main, numbers, p),
+        ),
+        (
+            "normalised_vs_single.png",
+            "Against single-task champions (Fig. 4)",
+            lambda p: plots.normalised_vs_single(main, numbers, p),
+        ),
+        (
+            "normalised_vs_reference.png",
+            "Against the reference best (Fig. 5)",
+            lambda p: plots.normalised_vs_reference(main, numbers, p),
+        ),
+    ]
+    if len(groups) > 1:
+        figures.append(
+            (
+                "ablations.png",
+                "Experiments and ablations (Fig. 6)",
+                lambda p: plots.ablations(groups, numbers, p),
+            )
+        )
+    figures += [
+        (
+            "hierarchy.png",
+            "Teams per decision by task subset (Fig. 7)",
+            lambda p: plots.hierarchy(main, numbers, p),
+        ),
+        (
+            "aggregate.png",
+            "Across seeds: interquartile mean with 95% CIs",
+            lambda p: plots_stats.aggregate(groups, numbers, estimates, p),
+        ),
+        (
+            "performance_profile.png",
+            "Across seeds: performance profile",
+            lambda p: plots_stats.profile(groups, numbers, p),
+        ),
+    ]
     sections = []
     for name, title, draw in figures:
-        png = draw(runs, out / name)
+        png = draw(out / name)
         data = base64.b64encode(png.read_bytes()).decode("ascii")
         sections.append(
             f'<h2>{html.escape(title)}</h2><img alt="{html.escape(title)}" '
             f'src="data:image/png;base64,{data}">'
         )
-    best = best_run(runs)
+    ordered = [(g.label, numbers[r.path]) for g in groups for r in g.runs]
+    ref = reference_best(tasks)
     tables = [
+        _stats_table(groups, estimates, tasks),
         _table(
-            "Final test return of each run's all-task champion",
+            "Test return of each run's all-task champion",
+            describe([n for _, n in ordered]),
             tasks,
-            {r.path.name: r.multitask_scores() for r in runs},
-        ),
-        _table(
-            "Normalised against the run's best single-task champions",
-            tasks,
-            {r.path.name: vs_single_task(r) for r in runs},
+            [(g, n.run.name, n.test) for g, n in ordered],
         ),
         _table(
             "Normalised against the reference best",
+            "0 = random play, 1 = reference best ("
+            + ", ".join(f"{t} {v:g}" for t, v in ref.items())
+            + ").",
             tasks,
-            {
-                f"{best.path.name} (best run)": normalise_scores(
-                    best.multitask_scores(), reference_best(tasks)
-                )
-            },
+            [(g, n.run.name, n.normalised) for g, n in ordered],
+        ),
+        _table(
+            "Normalised against the run's own single-task champions",
+            f"0 = random play, {SINGLE_RULE}; n/a where that champion does no better than "
+            "random play.",
+            tasks,
+            [(g, n.run.name, n.vs_single) for g, n in ordered],
+        ),
+        _table(
+            "Test return of each run's single-task champions (the denominators above)",
+            "Each task's single-task champion (best root on that task alone by training "
+            "score, same generation), tested on its own task.",
+            tasks,
+            [(g, n.run.name, n.single) for g, n in ordered],
         ),
     ]
-    runs_list = "".join(
-        f"<li>{html.escape(str(r.path))}: {html.escape(r.label)}, seed "
-        f"{r.config.seed}, {int(r.tests[-1]['generation'])} generations, "
-        f"{r.config.evaluation.test_episodes} test episodes per task</li>"
-        for r in runs
-    )
+    warn_html = "".join(f'<p class="warn">Warning: {html.escape(w)}</p>' for w in mixed)
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>mtpg report</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}}img{{max-width:100%}}
 table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}
-</style></head><body>
-<h1>mtpg report</h1><ul>{runs_list}</ul>
+.warn{{color:#a00;font-weight:bold}}</style></head><body>
+<h1>mtpg report</h1>{warn_html}
+<p>{html.escape(describe([n for _, n in ordered]))} {html.escape(BEST_RUN_RULE)}.</p>
+{_runs_list(groups, numbers)}
 {"".join(tables)}
 {"".join(sections)}
 </body></html>

@@ -1,8 +1,15 @@
-"""Loading finished runs and computing the normalised scores of paper section 5.
+"""Loading finished runs, grouping them by configuration, and normalising scores.
 
 ``normalised = (score - random) / (best - random)``: 0 is random play; ``best`` is either
-the best single-task champion of the same run (Figs. 4 and 6) or the reference best of the
-task (Fig. 5).
+a single-task champion (Figs. 4 and 6) or the reference best of the task (Fig. 5); see
+:mod:`mtpg.analysis.numbers` for which champion every reported number comes from.
+
+Runs are grouped by configuration: two runs belong to one group when their configurations
+are equal in everything but the seed and the settings that do not change what a run
+computes (``workers``, ``checkpoint_interval``). A group is labelled with its experiment
+(``TPG`` or an ablation of section 5.2) plus, when needed to tell groups apart, the fields in
+which it differs. Groups that differ in more than the ablation switches are a mixture the
+figures cannot compare fairly: :func:`group_runs` reports them as warnings.
 """
 
 from __future__ import annotations
@@ -10,13 +17,20 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from mtpg.config import RunConfig
+from mtpg.config import ABLATIONS, RunConfig, to_dict
 from mtpg.envs.core import TASK_NAMES
 from mtpg.envs.reference import REFERENCE, normalise
-from mtpg.evolve.session import TESTS_FILE, read_run_config
+from mtpg.io.runconfig import read_run_config
+from mtpg.io.rundir import TESTS_FILE
+
+#: Settings that do not change what a run computes: ignored when grouping.
+NOT_GROUPED = ("seed", "workers", "checkpoint_interval")
+#: The ablation switches (``section.field``): groups differing only in these are comparable.
+ABLATION_FIELDS = tuple(key for key, _ in ABLATIONS.values())
 
 
 def experiment_label(config: RunConfig) -> str:
@@ -47,14 +61,31 @@ class RunData:
     label: str = "TPG"
 
     @property
+    def name(self) -> str:
+        """The run directory's name."""
+        return self.path.name
+
+    @property
     def tasks(self) -> tuple[str, ...]:
         """Active task names."""
         return self.config.evaluation.tasks
 
     @property
     def full_set(self) -> str:
-        """Name of the subset of all active tasks."""
+        """Name of the subset of all active tasks (as in ``tests.csv``)."""
         return "+".join(self.tasks)
+
+    @property
+    def test_episodes(self) -> int:
+        """Held-out episodes per task at each test point."""
+        return self.config.evaluation.test_episodes
+
+    @property
+    def final_generation(self) -> int:
+        """The last test point (the run's last generation for a finished run)."""
+        if not self.tests:
+            raise ValueError(f"{self.path}: no test results yet ({TESTS_FILE} is empty)")
+        return int(max(r["generation"] for r in self.tests))
 
     def curve(self, subset: str, task: str) -> tuple[np.ndarray, np.ndarray]:
         """Test score on ``task`` of the champion of ``subset`` at each test point."""
@@ -64,21 +95,17 @@ class RunData:
             np.array([r[f"test_{task}"] for r in rows], dtype=float),
         )
 
-    def final(self, subset: str) -> dict[str, float | str]:
-        """The last test row of ``subset``."""
-        rows = [r for r in self.tests if r["subset"] == subset]
-        if not rows:
-            raise ValueError(f"{self.path}: no test results yet (tests.csv is empty)")
-        return rows[-1]
+    def row(self, subset: str, generation: int | None = None) -> dict[str, float | str]:
+        """The test row of ``subset`` at ``generation`` (default: the final test point)."""
+        gen = self.final_generation if generation is None else generation
+        for r in self.tests:
+            if r["subset"] == subset and int(r["generation"]) == gen:
+                return r
+        raise ValueError(f"{self.path}: no test of subset {subset} at generation {gen}")
 
-    def best_single(self, task: str) -> float:
-        """Best test score of the run's single-task champion of ``task`` over all test points."""
-        return float(self.curve(task, task)[1].max())
-
-    def multitask_scores(self) -> dict[str, float]:
-        """Final test score per task of the champion of all tasks."""
-        row = self.final(self.full_set)
-        return {t: float(row[f"test_{t}"]) for t in self.tasks}
+    def rows_at(self, generation: int) -> list[dict[str, float | str]]:
+        """Every subset's test row at ``generation``."""
+        return [r for r in self.tests if int(r["generation"]) == generation]
 
 
 def load_run(path: str | Path) -> RunData:
@@ -95,8 +122,79 @@ def load_run(path: str | Path) -> RunData:
     return RunData(path, config, rows, experiment_label(config))
 
 
+def _flat(config: RunConfig) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in to_dict(config).items():
+        if isinstance(value, dict):
+            out.update({f"{key}.{k}": v for k, v in value.items()})
+        else:
+            out[key] = value
+    return {k: v for k, v in out.items() if k not in NOT_GROUPED}
+
+
+@dataclass
+class RunGroup:
+    """Runs of one configuration (all seeds of one experiment).
+
+    Attributes:
+        label: Display label (experiment name, plus distinguishing settings if needed).
+        runs: The runs, in the order given.
+        settings: The group's configuration, flattened (``section.field`` keys).
+    """
+
+    label: str
+    runs: list[RunData]
+    settings: dict[str, Any]
+
+    @property
+    def experiment(self) -> str:
+        """``TPG`` or the ablation label."""
+        return self.runs[0].label
+
+
+def _value(v: Any) -> str:
+    return ",".join(map(str, v)) if isinstance(v, list) else str(v)
+
+
+def group_runs(runs: list[RunData]) -> tuple[list[RunGroup], list[str]]:
+    """Groups runs by configuration and names the mixtures.
+
+    Args:
+        runs: Loaded runs.
+
+    Returns:
+        ``(groups, warnings)``: groups in order of first appearance, full algorithm first;
+        one warning per setting (other than the ablation switches) in which groups differ.
+    """
+    groups: list[RunGroup] = []
+    for run in runs:
+        flat = _flat(run.config)
+        for g in groups:
+            if g.settings == flat:
+                g.runs.append(run)
+                break
+        else:
+            groups.append(RunGroup(run.label, [run], flat))
+    groups.sort(key=lambda g: g.experiment != "TPG")
+    differing = sorted(
+        k for k in groups[0].settings if len({repr(g.settings[k]) for g in groups}) > 1
+    )
+    beyond = [k for k in differing if k not in ABLATION_FIELDS]
+    for g in groups:
+        same = [h for h in groups if h.experiment == g.experiment]
+        if len(same) > 1:
+            g.label += " (" + ", ".join(f"{k}={_value(g.settings[k])}" for k in beyond) + ")"
+    warnings = [
+        f"runs differ in {k}: "
+        + "; ".join(f"{g.label}: {_value(g.settings[k])}" for g in groups)
+        + " (grouped separately; figures compare groups that are not like for like)"
+        for k in beyond
+    ]
+    return groups, warnings
+
+
 def normalise_scores(scores: dict[str, float], best: dict[str, float]) -> dict[str, float]:
-    """``(score - random) / (best - random)`` per task, with the stored random means."""
+    """``(score - random) / (best - random)`` per task; NaN when ``best`` equals random."""
     out = {}
     for task, score in scores.items():
         try:
@@ -109,13 +207,3 @@ def normalise_scores(scores: dict[str, float], best: dict[str, float]) -> dict[s
 def reference_best(tasks: tuple[str, ...]) -> dict[str, float]:
     """The reference best score of each task (Fig. 5)."""
     return {t: REFERENCE[TASK_NAMES.index(t)].best for t in tasks}
-
-
-def vs_single_task(run: RunData) -> dict[str, float]:
-    """The run's multi-task champion normalised by its best single-task champions (Fig. 4)."""
-    return normalise_scores(run.multitask_scores(), {t: run.best_single(t) for t in run.tasks})
-
-
-def best_run(runs: list[RunData]) -> RunData:
-    """The run whose multi-task champion has the highest minimum normalised score."""
-    return max(runs, key=lambda r: np.nanmin(list(vs_single_task(r).values()) + [np.inf]))

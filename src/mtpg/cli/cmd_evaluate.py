@@ -21,7 +21,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("target", metavar="GRAPH_OR_RUN", help="a graph .json file or a run directory")
     p.add_argument("--tasks", help="comma-separated tasks (default: the graph's or run's tasks)")
-    p.add_argument("--episodes", type=int, default=100, help="episodes per task (default 100)")
+    p.add_argument(
+        "--episodes",
+        type=int,
+        help="episodes per task (default: a run's evaluation.test_episodes, so the numbers "
+        "equal its report; 100 for a graph file)",
+    )
     p.add_argument("--seed", type=int, default=0, help="test seed offset (default 0)")
     p.add_argument("--workers", type=int, default=1, help="threads (default 1)")
     p.add_argument("--json", action="store_true", help="print one JSON object instead")
@@ -32,21 +37,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def resolve_graph(target: Path):
     """Loads the graph a path names: a graph file, or a run's all-task champion.
 
+    For a run directory this is the champion the report shows
+    (:func:`mtpg.analysis.numbers.champion_path`: the all-task champion at the final test
+    point, chosen by training score), or the latest champion of a run without tests.
+
     Returns:
         ``(population, root, meta, default task names)``.
     """
-    from mtpg.evolve.session import read_run_config
-    from mtpg.io.rundir import RunDir, champion_filename
+    from mtpg.analysis.numbers import champion_path
+    from mtpg.analysis.runs import load_run
+    from mtpg.io.runconfig import read_run_config
+    from mtpg.io.rundir import TESTS_FILE, RunDir, champion_filename
     from mtpg.io.serialize import load_graph
 
     if target.is_dir():
-        evaluation = read_run_config(target).evaluation
-        tasks = list(evaluation.tasks)
+        config = read_run_config(target)
+        tasks = list(config.evaluation.tasks)
         path = RunDir(target).champions / champion_filename(tuple(tasks))
+        if (target / TESTS_FILE).is_file() and load_run(target).tests:
+            path = champion_path(load_run(target))
         if not path.is_file():
             raise FileNotFoundError(f"{path}: the run has no champion yet")
         pop, root, meta = load_graph(path)
-        meta.setdefault("no_memory", evaluation.no_memory)  # champions of older runs
+        meta.setdefault("no_memory", config.evaluation.no_memory)  # the run's ablation
+        meta.setdefault("test_episodes", config.evaluation.test_episodes)
         return pop, root, meta, tasks
     pop, root, meta = load_graph(target)
     from mtpg.envs.core import TASK_NAMES
@@ -61,11 +75,15 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.protocol import N_TEST_EPISODES
     from mtpg.envs.tasks import MAX_STEPS
     from mtpg.limits import check_evaluation_fits
 
-    check_options(args)
     pop, root, meta, tasks = resolve_graph(Path(args.target))
+    if args.episodes is None:  # a run's own protocol, so evaluate and report agree
+        is_run = Path(args.target).is_dir()
+        args.episodes = int(meta["test_episodes"]) if is_run else N_TEST_EPISODES
+    check_options(args)
     if args.tasks is not None:
         tasks = task_list(args.tasks)
     unknown = [t for t in tasks if t not in TASK_NAMES]
@@ -77,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     single = single_task_bests(Path(args.target), tasks)
     out = {t: {**s.as_dict(), "no_memory": no_memory, "memory": memory} for t, s in scores.items()}
     for t, best in single.items():
-        out[t]["best_single_task"] = best
+        out[t]["single_task_champion"] = best
         out[t]["normalised_single_task"] = normalise_scores({t: scores[t].mean}, {t: best})[t]
     if args.json:  # strict JSON: an undefined ratio (best = random) is null
         clean = {
@@ -86,13 +104,20 @@ def run(args: argparse.Namespace) -> int:
         }
         print(json.dumps(clean, allow_nan=False))
         return 0
+    from mtpg.envs.protocol import describe_held_out
+
+    where = (
+        f"all-task champion at generation {meta['generation']} (best root by training score)"
+        if Path(args.target).is_dir() and "generation" in meta
+        else "graph file"
+    )
     print(
-        f"{args.target}: root team {root}, {len(pop.reachable(root))} teams; "
-        f"{args.episodes} test episodes per task (seed offset {args.seed}); {memory}"
+        f"{args.target}: {where}, root team {root}, {len(pop.reachable(root))} teams; "
+        f"{describe_held_out(args.episodes, args.seed)}; {memory}"
     )
     print(
         "normalised: 0 = random play, 1 = reference best"
-        + ("; vs single: 1 = the run's best single-task champion" if single else "")
+        + ("; vs single: 1 = the run's own single-task champion, same generation" if single else "")
     )
     header = f"{'task':<22} {'mean':>10} {'std':>9} {'normalised':>10} {'teams/dec':>9}"
     print(header + (f" {'vs single':>9}" if single else ""))
@@ -102,7 +127,8 @@ def run(args: argparse.Namespace) -> int:
             f"{s.teams_per_decision:>9.2f}"
         )
         if t in single:
-            line += f" {out[t]['normalised_single_task']:>9.3f}"
+            v = out[t]["normalised_single_task"]
+            line += f" {v:>9.3f}" if v == v else f" {'n/a':>9}"  # n/a: champion = random
         print(line)
     return 0
 
@@ -122,10 +148,18 @@ def check_options(args: argparse.Namespace) -> None:
 
 
 def single_task_bests(target: Path, tasks: list[str]) -> dict[str, float]:
-    """Best test score of each task's single-task champion, for a run directory with tests."""
-    from mtpg.analysis.runs import load_run
+    """Test score of each task's single-task champion at the run's final test point.
 
-    if not (target.is_dir() and (target / "tests.csv").is_file()):
+    The denominators of ``vs single`` (:mod:`mtpg.analysis.numbers`): chosen by training
+    score, never by test score; empty for a graph file or a run without tests.
+    """
+    from mtpg.analysis.runs import load_run
+    from mtpg.io.rundir import TESTS_FILE
+
+    if not (target.is_dir() and (target / TESTS_FILE).is_file()):
         return {}
     run = load_run(target)
-    return {t: run.best_single(t) for t in tasks if t in run.tasks and run.curve(t, t)[0].size}
+    if not run.tests:
+        return {}
+    gen = run.final_generation
+    return {t: float(run.row(t, gen)[f"test_{t}"]) for t in tasks if t in run.tasks}

@@ -45,6 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     from mtpg.cli.cmd_train import overrides
     from mtpg.cli.main import UsageError, build_parser
+    from mtpg.cli.progress import ExperimentProgress
     from mtpg.config import build_config
     from mtpg.evolve.experiment import execute, plan
     from mtpg.evolve.stopping import GracefulStop, exit_code
@@ -78,15 +79,20 @@ def run(args: argparse.Namespace) -> int:
         GracefulStop("mtpg experiment", "the running trainings stop") as stop,
     ):
         lock.claim()
-        failed = execute(
-            runs,
-            train_args,
-            config.generations,
-            args.parallel,
-            workers,
-            log=lambda m: print(m, file=sys.stderr),
-            stop=stop,
-        )
+        watch = ExperimentProgress(runs, config.generations, lambda m: print(m, file=sys.stderr))
+        watch.start()
+        try:
+            failed = execute(
+                runs,
+                train_args,
+                config.generations,
+                args.parallel,
+                workers,
+                log=lambda m: print(m, file=sys.stderr),
+                stop=stop,
+            )
+        finally:
+            watch.stop()
     if stop.signum is not None:
         print(f"stopped by {stop.name}; rerun the command to resume", file=sys.stderr)
         return exit_code(stop.signum)

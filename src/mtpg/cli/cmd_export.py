@@ -60,7 +60,7 @@ def resolve_path(target: Path) -> tuple[Path, list[str] | None]:
         if not target.is_file():
             raise FileNotFoundError(f"{target}: no such graph file or run directory")
         return target, None
-    from mtpg.evolve.session import read_run_config
+    from mtpg.io.runconfig import read_run_config
     from mtpg.io.rundir import RunDir, champion_filename
 
     tasks = list(read_run_config(target).evaluation.tasks)
@@ -132,13 +132,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _bench(args, graph, pop, root, task_ids: list[int]) -> int:
     from mtpg.cli.main import UsageError
-    from mtpg.evolve.trainer import test_seeds
+    from mtpg.envs.protocol import held_out_seeds
     from mtpg.export.bench import benchmark
     from mtpg.export.harness import engine_stream, find_compiler
 
     if find_compiler() is None:
         raise FileNotFoundError("no C compiler found for --bench (set CC or install cc/gcc)")
-    seeds = test_seeds(args.bench_episodes)
+    seeds = held_out_seeds(args.bench_episodes)
     stream = engine_stream(pop, root, task_ids, seeds, no_memory=graph.no_memory)
     try:
         res = benchmark(graph, pop, root, stream, runs=args.bench_runs)

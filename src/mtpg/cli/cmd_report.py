@@ -11,7 +11,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "report",
         help="figures and an HTML page from run directories",
         description="Draw the figures of paper section 5 (learning curves, normalised scores, "
-        "ablations, teams per decision) from the test results of one or more runs.",
+        "ablations, teams per decision) and the statistics across seeds (interquartile mean "
+        "with 95%% stratified bootstrap confidence intervals, performance profile) from the "
+        "test results of one or more runs. Runs are grouped by configuration; runs that "
+        "differ in more than the seed and the ablation switches are reported with a warning.",
     )
     p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="run directories")
     p.add_argument("--out", metavar="DIR", help="output directory (default: RUN_DIR/report)")
@@ -20,8 +23,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.report import build_report
+    import sys
+    import warnings
 
-    index = build_report(args.runs, args.out)
+    from mtpg.analysis.report import MixedRunsWarning, build_report
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MixedRunsWarning)
+        index = build_report(args.runs, args.out)
+    for w in caught:
+        if issubclass(w.category, MixedRunsWarning):
+            print(f"warning: {w.message}", file=sys.stderr)
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     print(index)
     return 0

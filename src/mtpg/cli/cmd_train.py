@@ -113,7 +113,7 @@ def run(args: argparse.Namespace) -> int:
             f" of {cfg.generations}; tasks: {', '.join(cfg.evaluation.tasks)})",
             file=sys.stderr,
         )
-        progress = None if args.quiet else Progress(cfg.generations, cfg.evaluation.tasks)
+        progress = None if args.quiet else Progress.for_session(session)
         try:
             finished = session.run_all(progress, stop.requested)
         except StopNow as exc:

@@ -1,12 +1,27 @@
-"""Progress display of a training run: a live status line on a terminal, plain lines else."""
+"""Progress displays: a training run's generations, and the runs of an experiment.
+
+A training run prints a header naming every column, a line while the first generation
+compiles, then one status line per generation (rewritten in place on a terminal):
+
+    gen 12/250 | 0.74 s/gen | left 2m51s | 6.86M dec/s | train best CP 50 AB -200 |
+    test@10 CP 38.2 AB -500 | teams/dec 1.01
+
+``train best`` is the best training score of any root on each task (a different root may be
+best on each, and training uses only a few episodes): it is not what the run has learnt.
+``test@G`` is the all-task champion's mean return on the held-out episodes at the last test
+point G: the number the report shows.
+"""
 
 from __future__ import annotations
 
+import csv
 import sys
+import threading
 import time
+from pathlib import Path
 from typing import TextIO
 
-#: Short task labels for the status line.
+#: Short task labels for the status line (the header spells them out).
 SHORT = {
     "CartPole": "CP",
     "Acrobot": "AB",
@@ -21,14 +36,42 @@ def _fmt_rate(x: float) -> str:
     return f"{x / 1e6:.2f}M" if x >= 1e6 else f"{x / 1e3:.0f}k"
 
 
+def fmt_duration(seconds: float) -> str:
+    """``"42s"``, ``"3m07s"`` or ``"2h05m"``."""
+    s = int(round(max(seconds, 0.0)))
+    if s < 60:
+        return f"{s}s"
+    if s < 3600:
+        return f"{s // 60}m{s % 60:02d}s"
+    return f"{s // 3600}h{s % 3600 // 60:02d}m"
+
+
+def last_test(tests_file: Path | None, subset: str) -> tuple[int, dict[str, float]] | None:
+    """The last test row of ``subset`` in a ``tests.csv``: ``(generation, task -> score)``."""
+    if tests_file is None or not tests_file.is_file():
+        return None
+    found = None
+    with open(tests_file, encoding="utf-8") as fh:
+        for row in csv.DictReader(fh):
+            if row.get("subset") == subset:
+                found = row
+    if found is None:
+        return None
+    scores = {k[5:]: float(v) for k, v in found.items() if k.startswith("test_")}
+    return int(float(found["generation"])), scores
+
+
 class Progress:
-    """Reports each generation.
+    """Reports each generation of a training run.
 
     Args:
         total: The run's last generation.
         tasks: Active task names.
         stream: Where to write (standard error by default).
         live: Rewrite one status line in place; default: when ``stream`` is a terminal.
+        tests_file: The run's ``tests.csv``, for the champion's last test score.
+        train_episodes: Training episodes per task (named in the header).
+        test_episodes: Held-out episodes per task at a test point (named in the header).
     """
 
     def __init__(
@@ -37,26 +80,114 @@ class Progress:
         tasks: tuple[str, ...],
         stream: TextIO | None = None,
         live: bool | None = None,
+        tests_file: Path | None = None,
+        train_episodes: int | None = None,
+        test_episodes: int | None = None,
     ) -> None:
         self.total = total
         self.tasks = tasks
         self.stream = stream or sys.stderr
         self.live = self.stream.isatty() if live is None else live
         self.start = time.perf_counter()
+        self.tests_file = tests_file
+        self.train_episodes = train_episodes
+        self.test_episodes = test_episodes
+        self.test: tuple[int, dict[str, float]] | None = None
+        self._last = self.start
+        self._durations: list[float] = []
+        self._header_done = False
+
+    @classmethod
+    def for_session(cls, session, **kwargs) -> Progress:
+        """A display for a :class:`mtpg.evolve.session.Session`, announced on the stream.
+
+        Prints the header and the "compiling" line at once (the first generation compiles
+        the engine's kernels, which takes seconds before anything else appears).
+        """
+        from mtpg.io.rundir import TESTS_FILE
+
+        ev = session.config.evaluation
+        progress = cls(
+            session.config.generations,
+            ev.tasks,
+            tests_file=Path(session.run.path) / TESTS_FILE,
+            train_episodes=ev.train_episodes,
+            test_episodes=ev.test_episodes,
+            **kwargs,
+        )
+        progress.test = last_test(progress.tests_file, "+".join(ev.tasks))
+        progress.begin(session.trainer.state.generation)
+        return progress
+
+    def header(self) -> str:
+        """The lines that name every column of the status line."""
+        names = ", ".join(f"{SHORT[t]} = {t}" for t in self.tasks)
+        train = f"mean of {self.train_episodes} training episodes" if self.train_episodes else ""
+        test = f"{self.test_episodes} held-out episodes" if self.test_episodes else "held-out"
+        return (
+            "columns: gen = generations done/total | s/gen = seconds of the last generation | "
+            "left = estimated time left | dec/s = graph decisions per second\n"
+            f"  train best = best training score of any root on each task ({train}; the best "
+            "root may differ per task, so this is not the champion's score)\n"
+            f"  test@G = the all-task champion's mean return on {test} per task at the last "
+            "test point G (what `mtpg report` and `mtpg evaluate` show)\n"
+            f"  tasks: {names}"
+        )
+
+    def _write_header(self) -> None:
+        if not self._header_done:
+            self.stream.write(self.header() + "\n")
+            self._header_done = True
+
+    def begin(self, generation: int = 0) -> None:
+        """Prints the header and a line saying the next generation compiles first."""
+        self._write_header()
+        text = (
+            f"gen {generation + 1}/{self.total}: compiling the engine's kernels (cached after "
+            "the first run), then evaluating..."
+        )
+        self.stream.write(("\r\x1b[2K" + text) if self.live else text + "\n")
+        self.stream.flush()
+        self._last = time.perf_counter()
+
+    def eta(self, generation: int) -> float:
+        """Seconds left: mean duration of the recent generations times those remaining.
+
+        The first generation of a process (it compiles the kernels) is left out, so there
+        is no estimate (NaN, shown as "?") until a second generation has run.
+        """
+        recent = self._durations[1:]
+        if not recent:
+            return float("nan")
+        recent = recent[-20:]
+        return sum(recent) / len(recent) * max(self.total - generation, 0)
 
     def line(self, row: dict[str, float]) -> str:
         """The status text of one metrics row."""
-        elapsed = time.perf_counter() - self.start
-        scores = " ".join(f"{SHORT[t]} {row[f'best_{t}']:.4g}" for t in self.tasks)
+        gen = int(row["generation"])
+        took = self._durations[-1] if self._durations else float(row.get("t_total", 0.0))
+        left = self.eta(gen)
+        train = " ".join(f"{SHORT[t]} {row[f'best_{t}']:.4g}" for t in self.tasks)
+        if self.test is not None:
+            g, scores = self.test
+            test = f"test@{g} " + " ".join(f"{SHORT[t]} {scores[t]:.4g}" for t in self.tasks)
+        else:
+            test = "test: none yet"
         return (
-            f"gen {int(row['generation'])}/{self.total}  {elapsed:7.1f}s  "
-            f"{_fmt_rate(row['decisions_per_s'])} dec/s  best: {scores}  "
-            f"teams/decision {row['teams_per_decision']:.2f}  "
-            f"champion teams {int(row['champion_teams'])}"
+            f"gen {gen}/{self.total} | {took:.2f} s/gen | "
+            f"left {fmt_duration(left) if left == left else '?'} | "
+            f"{_fmt_rate(row['decisions_per_s'])} dec/s | train best {train} | {test} | "
+            f"teams/dec {row['teams_per_decision']:.2f}"
         )
 
     def __call__(self, row: dict[str, float], _trainer: object = None) -> None:
         """Shows one generation."""
+        now = time.perf_counter()
+        self._durations.append(now - self._last)
+        self._last = now
+        self._write_header()
+        if row.get("t_test", 0.0) > 0 or int(row["generation"]) >= self.total:
+            self.test = last_test(self.tests_file, "+".join(self.tasks)) or self.test
         text = self.line(row)
         if self.live:
             self.stream.write("\r\x1b[2K" + text)
@@ -71,3 +202,83 @@ class Progress:
         if self.live:
             self.stream.write("\n")
             self.stream.flush()
+
+
+def run_generation(run_dir: Path) -> int:
+    """Generations recorded in a run's ``metrics.csv`` (0 when it has none yet)."""
+    from mtpg.io.rundir import RunDir
+
+    path = RunDir(Path(run_dir)).metrics
+    try:
+        lines = path.read_text(encoding="utf-8").strip().splitlines()
+    except OSError:
+        return 0
+    if len(lines) < 2:
+        return 0
+    try:
+        return int(float(lines[-1].split(",", 1)[0]))
+    except ValueError:
+        return 0
+
+
+class ExperimentProgress:
+    """Reports the generation of every run of an experiment while it runs.
+
+    A background thread reads each run's ``metrics.csv`` every ``interval`` seconds and
+    logs one line when anything moved, e.g.
+    ``progress 3/8 done | TPG-seed1 gen 12/62 (left ~1m40s) | TPG-seed2 waiting``.
+
+    Args:
+        runs: Objects with a ``path`` (run directory), e.g. planned runs.
+        generations: Generations per run.
+        log: Called with each line.
+        interval: Seconds between checks.
+    """
+
+    def __init__(self, runs, generations: int, log, interval: float = 15.0) -> None:
+        self.runs = list(runs)
+        self.generations = generations
+        self.log = log
+        self.interval = interval
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._seen: dict[Path, tuple[float, int]] = {}
+        self._last_text = ""
+
+    def status(self) -> str:
+        """One line with every unfinished run's generation and estimated time left."""
+        now = time.monotonic()
+        parts, done = [], 0
+        for run in self.runs:
+            gen = run_generation(run.path)
+            if gen >= self.generations:
+                done += 1
+                continue
+            if gen == 0:
+                parts.append(f"{run.path.name} waiting")
+                continue
+            first = self._seen.setdefault(run.path, (now, gen))
+            rate = (gen - first[1]) / (now - first[0]) if now > first[0] else 0.0
+            left = f" (left ~{fmt_duration((self.generations - gen) / rate)})" if rate > 0 else ""
+            parts.append(f"{run.path.name} gen {gen}/{self.generations}{left}")
+        return " | ".join([f"progress {done}/{len(self.runs)} runs done", *parts])
+
+    def _loop(self) -> None:
+        while not self._stop.wait(self.interval):
+            text = self.status()
+            if text != self._last_text:
+                self.log(text)
+                self._last_text = text
+
+    def start(self) -> ExperimentProgress:
+        """Starts reporting in a daemon thread."""
+        self.status()  # note where every run starts, for the time estimates
+        self._thread = threading.Thread(target=self._loop, daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        """Stops reporting."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()

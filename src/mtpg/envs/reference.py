@@ -25,13 +25,13 @@ from typing import NamedTuple
 import numpy as np
 
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
+from mtpg.envs.protocol import (  # noqa: F401  (the seed bases live in protocol)
+    N_TEST_EPISODES,
+    RANDOM_SEED_BASE,
+    TEST_SEED_BASE,
+    held_out_seeds,
+)
 
-#: First episode seed of the test episodes.
-TEST_SEED_BASE = 1_000_000
-#: Number of test episodes per task.
-N_TEST_EPISODES = 100
-#: First episode seed of the random-agent measurement.
-RANDOM_SEED_BASE = 2_000_000
 #: Seed of the random agent's action generator.
 RANDOM_ACTION_SEED = 12345
 #: Episodes of the random-agent measurement.
@@ -48,7 +48,7 @@ def make_test_seeds(n: int = N_TEST_EPISODES) -> np.ndarray:
     Returns:
         int64 [n] seeds.
     """
-    return TEST_SEED_BASE + np.arange(n, dtype=np.int64)
+    return held_out_seeds(n)
 
 
 class Reference(NamedTuple):

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.evolve.persist import state_to_payload
-from mtpg.evolve.trainer import Trainer, metric_columns, test_columns
+from mtpg.evolve.trainer import Trainer, held_out_columns, metric_columns
 from mtpg.io.checkpoint import checkpoint_path, prune_checkpoints, save_checkpoint
 from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, MetricsWriter, champion_filename, write_champions
 from mtpg.io.serialize import save_graph
@@ -96,9 +96,9 @@ def generations(
     while not trainer.done and not (should_stop and should_stop()):
         row = trainer.run_generation()
         tests = None
-        if trainer.test_due():
+        if trainer.held_out_due():
             start = time.perf_counter()
-            tests = trainer.test_champions()
+            tests = trainer.held_out_scores()
             row["t_test"] = time.perf_counter() - start
             row["t_total"] += row["t_test"]
         yield Generation(trainer.state.generation, row, tests)
@@ -158,7 +158,7 @@ class TestsReporter(Reporter):
 
     def __init__(self, run_path: Path, tasks: tuple[str, ...]) -> None:
         self.run_path = run_path
-        self.writer = MetricsWriter(run_path / TESTS_FILE, test_columns(tasks))
+        self.writer = MetricsWriter(run_path / TESTS_FILE, held_out_columns(tasks))
 
     def generation(self, gen: Generation, trainer: Trainer) -> None:
         """Writes the rows and graphs of a test point."""

@@ -18,12 +18,11 @@ Guarantees (see ``docs/runs.md``):
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from mtpg.config import ConfigError, RunConfig, from_dict, to_toml
+from mtpg.config import ConfigError, RunConfig, to_toml
 from mtpg.evolve.persist import (
     RESUMABLE_CHANGES,
     config_differences,
@@ -47,8 +46,8 @@ from mtpg.io.checkpoint import (
     load_checkpoint,
 )
 from mtpg.io.lock import DirLock, lock_dir
+from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import (
-    RunDir,
     champion_filename,
     check_new_run_dir,
     check_resumable,
@@ -62,25 +61,6 @@ from mtpg.limits import check_training_fits
 __all__ = ["RESUMABLE_CHANGES", "TESTS_FILE", "Session", "read_run_config"]
 
 Callback = Callable[[dict[str, float], Trainer], None]
-
-
-def read_run_config(run_dir: str | Path) -> RunConfig:
-    """Reads the resolved configuration stored in a run directory."""
-    path = RunDir(Path(run_dir)).config
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (FileNotFoundError, NotADirectoryError):
-        check_resumable(run_dir)  # says why when the directory holds no run
-        raise ConfigError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
-        raise ConfigError(f"{path}: cannot read: {why}") from exc
-    try:
-        return from_dict(tomllib.loads(text))
-    except (tomllib.TOMLDecodeError, ConfigError) as exc:
-        raise ConfigError(f"{path}: {exc}") from exc
-    except RecursionError:
-        raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
 
 
 def load_state(

@@ -15,14 +15,12 @@ from mtpg.config import RunConfig
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.reference import TEST_SEED_BASE
+from mtpg.envs.protocol import held_out_seeds, training_seeds
 from mtpg.evolve.selection import select, task_subsets
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
 from mtpg.testhook import point
 
-#: Training episode ``k`` of every task uses episode seed ``TRAIN_SEED_BASE + k``.
-TRAIN_SEED_BASE = 0
 #: Metrics columns that measure time and so differ between otherwise identical runs.
 TIMING_COLUMNS = (
     "decisions_per_s",
@@ -34,14 +32,7 @@ TIMING_COLUMNS = (
 )
 
 
-def test_seeds(episodes: int, offset: int = 0) -> np.ndarray:
-    """Seeds of held-out test episodes: ``TEST_SEED_BASE + offset + k``, never training seeds."""
-    if offset < 0:
-        raise ValueError(f"test seed offset must be >= 0, got {offset}")
-    return TEST_SEED_BASE + offset + np.arange(episodes, dtype=np.int64)
-
-
-def test_columns(tasks: tuple[str, ...]) -> list[str]:
+def held_out_columns(tasks: tuple[str, ...]) -> list[str]:
     """The ``tests.csv`` header for a run on ``tasks``."""
     return ["generation", "subset", "root", "graph_teams", "teams_per_decision"] + [
         f"test_{t}" for t in tasks
@@ -112,7 +103,7 @@ class Trainer:
         ev = config.evaluation
         self.task_ids = list(ev.task_ids)
         self.subsets = task_subsets(len(self.task_ids))
-        seeds = TRAIN_SEED_BASE + np.arange(ev.train_episodes)
+        seeds = training_seeds(ev.train_episodes)
         self.episodes = Episodes.grid(self.task_ids, seeds)
 
     @property
@@ -152,24 +143,30 @@ class Trainer:
         st.generation = gen
         return self._metrics(new_roots, result, (t0, t1, t2, t3))
 
-    def test_due(self) -> bool:
-        """True when the generation just completed is a test point."""
-        interval = self.config.evaluation.test_interval
-        return interval > 0 and self.state.generation % interval == 0
+    def held_out_due(self) -> bool:
+        """True when the generation just completed is a test point.
 
-    def test_champions(self) -> list[dict[str, float | int | str]]:
+        Test points are every ``test_interval`` generations and, whatever the interval, the
+        run's last generation, so every run ends with test results of its final champions
+        (a 12-generation run with interval 5 is tested at 5, 10 and 12).
+        """
+        interval = self.config.evaluation.test_interval
+        gen = self.state.generation
+        return interval > 0 and (gen % interval == 0 or gen == self.config.generations)
+
+    def held_out_scores(self) -> list[dict[str, float | int | str]]:
         """Tests the champion of every task subset on held-out episodes of every task.
 
         Each distinct champion plays ``test_episodes`` episodes of each active task (seeds
-        from :func:`test_seeds`); nothing random is drawn, so testing leaves the run
+        from :func:`held_out_seeds`); nothing random is drawn, so testing leaves the run
         unchanged.
 
         Returns:
-            One row per subset (``test_columns`` keys), in subset order.
+            One row per subset (``held_out_columns`` keys), in subset order.
         """
         st, ev = self.state, self.config.evaluation
         roots = sorted(set(st.champions))
-        table = Episodes.grid(self.task_ids, test_seeds(ev.test_episodes))
+        table = Episodes.grid(self.task_ids, held_out_seeds(ev.test_episodes))
         cp = compile_population(st.population)
         returns, result = evaluate_roots(cp, roots, table, self.config.workers, ev.no_memory)
         n = len(self.task_ids)

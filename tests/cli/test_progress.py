@@ -1,0 +1,100 @@
+import io
+from types import SimpleNamespace
+
+from mtpg.cli.main import main
+from mtpg.cli.progress import ExperimentProgress, Progress, fmt_duration, last_test
+from tinyruns import tiny_args
+
+
+def row(gen, **extra):
+    base = {
+        "generation": gen,
+        "decisions_per_s": 2.5e6,
+        "teams_per_decision": 1.25,
+        "best_CartPole": 200.0,
+        "best_MountainCar": -150.0,
+        "t_total": 1.0,
+        "t_test": 0.0,
+    }
+    return {**base, **extra}
+
+
+def test_header_names_every_column_and_lines_show_test_and_eta(tmp_path):
+    tests = tmp_path / "tests.csv"
+    tests.write_text(
+        "generation,subset,root,graph_teams,teams_per_decision,test_CartPole,test_MountainCar\n"
+        "5,CartPole+MountainCar,7,3,1.5,70.25,-200.0\n"
+    )
+    out = io.StringIO()
+    p = Progress(
+        10,
+        ("CartPole", "MountainCar"),
+        out,
+        live=False,
+        tests_file=tests,
+        train_episodes=3,
+        test_episodes=20,
+    )
+    p.begin(0)
+    p(row(1))
+    assert "left ? " in out.getvalue()  # no estimate from the compiling generation alone
+    p._durations = [8.0, 2.0, 2.0]  # compilation, then two 2-second generations
+    assert p.eta(4) == 12.0  # 6 generations left x 2 s, compilation left out
+    p(row(5, t_test=0.5))
+    text = out.getvalue()
+    header = text.split("gen 1/10")[0]
+    for words in (
+        "train best",
+        "best training score of any root",
+        "test@G",
+        "20 held-out episodes",
+        "left = estimated time left",
+        "s/gen",
+        "CP = CartPole",
+        "MC = MountainCar",
+        "mean of 3 training episodes",
+    ):
+        assert words in header, words
+    assert "gen 1/10: compiling" in text  # before the first generation appears
+    last = text.strip().splitlines()[-1]
+    assert "test@5 CP 70.25 MC -200" in last and "train best CP 200 MC -150" in last
+    assert "left " in last and "s/gen" in last
+
+
+def test_train_prints_header_compiling_line_and_final_test(tmp_path, capsys):
+    args = tiny_args(quiet=False, evaluation__test_interval=5, evaluation__test_episodes=3)
+    assert main(["train", *args, "--generations", "7", "--out", str(tmp_path / "r")]) == 0
+    err = capsys.readouterr().err
+    assert err.index("columns:") < err.index("compiling") < err.index("gen 1/7 |")
+    assert "test@7 " in err.strip().splitlines()[-2]  # the last generation is a test point
+    assert last_test(tmp_path / "r" / "tests.csv", "CartPole+CartCentering")[0] == 7
+
+
+def test_experiment_progress_reads_each_runs_metrics(tmp_path):
+    runs = []
+    for name, gens in (("a", 3), ("b", 1), ("c", 0)):
+        d = tmp_path / name
+        d.mkdir()
+        if gens:
+            (d / "metrics.csv").write_text(
+                "generation,roots\n" + "".join(f"{g},1\n" for g in range(1, gens + 1))
+            )
+        runs.append(SimpleNamespace(path=d))
+    lines = []
+    watch = ExperimentProgress(runs, 3, lines.append, interval=0.01)
+    text = watch.status()
+    assert text.startswith("progress 1/3 runs done")
+    assert "b gen 1/3" in text and "c waiting" in text and "a gen" not in text
+    watch.start()
+    (tmp_path / "c" / "metrics.csv").write_text("generation,roots\n1,1\n")
+    import time
+
+    deadline = time.monotonic() + 5
+    while not any("c gen 1/3" in line for line in lines) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    watch.stop()
+    assert any("c gen 1/3" in line for line in lines)
+
+
+def test_durations():
+    assert [fmt_duration(s) for s in (5, 187, 7500)] == ["5s", "3m07s", "2h05m"]

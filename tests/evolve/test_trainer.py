@@ -103,7 +103,7 @@ def test_ablation_switches_change_exactly_what_they_name(switch, field, value):
 
 
 def test_no_memory_flag_reaches_the_engine(monkeypatch):
-    import mtpg.evolve.trainer as trainer_module
+    import mtpg.engine.evaluator as trainer_module
 
     seen = []
     real = trainer_module.evaluate_roots

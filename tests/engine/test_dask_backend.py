@@ -1,0 +1,116 @@
+"""The dask backend gives the local backend's results, also when a worker dies."""
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from mtpg.config import build_config  # noqa: E402
+from mtpg.engine.batch import Episodes, evaluate_roots  # noqa: E402
+from mtpg.engine.compile import compile_population  # noqa: E402
+from mtpg.engine.dask_backend import DaskEvaluator, plan_batches  # noqa: E402
+from mtpg.engine.workload import tangled_population  # noqa: E402
+from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer  # noqa: E402
+
+TINY = [
+    "team.root_size=30",
+    "team.n_elite=3",
+    "team.init_team_size=3",
+    "evaluation.train_episodes=2",
+    'evaluation.tasks=["CartPole", "MountainCar"]',
+    "evaluation.test_episodes=3",
+    "team.p_atomic=0.7",
+]
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    ev = DaskEvaluator(n_workers=2, min_roots=1)
+    yield ev
+    ev.close()
+
+
+def tiny(*extra, generations=4):
+    return build_config("paper", overrides=[*TINY, f"generations={generations}", *extra])
+
+
+def run(config, evaluator=None):
+    """Metrics (timing aside), test rows after every generation, and champions."""
+    trainer = Trainer(config)
+    if evaluator is not None:
+        trainer.evaluator = evaluator
+    rows, tests = [], []
+    while not trainer.done:
+        row = trainer.run_generation()
+        rows.append({k: v for k, v in row.items() if k not in TIMING_COLUMNS})
+        tests.append(trainer.test_champions())
+    return rows, tests, trainer.state.champions
+
+
+def test_plan_batches_about_four_per_thread_with_enough_roots_each():
+    assert plan_batches(6000, 30, threads=8, min_roots=10) == 20  # 200 roots: 20 of 10
+    assert plan_batches(60000, 30, threads=8, min_roots=10) == 32  # 4 per thread
+    assert plan_batches(30, 30, threads=8, min_roots=10) == 1
+    assert plan_batches(5, 1, threads=2, min_roots=1) == 5
+
+
+@pytest.mark.parametrize("no_memory", [False, True])
+def test_batches_equal_the_local_engine(cluster, no_memory):
+    pop = tangled_population(np.random.default_rng(3), 60, 150, 12, 20)
+    cp = compile_population(pop)
+    roots = sorted(pop.teams)[::2]
+    eps = Episodes.grid([0, 1, 2, 4], [0, 1, 2])
+    want, w = evaluate_roots(cp, roots, eps, 1, no_memory)
+    got, g = cluster.evaluate(cp, roots, eps, no_memory)
+    assert np.array_equal(want, got)
+    for a, b in zip(
+        (w.steps, w.teams, w.instructions), (g.steps, g.teams, g.instructions), strict=True
+    ):
+        assert np.array_equal(a, b)
+
+
+def test_training_on_dask_equals_local_threads(cluster):
+    one = run(tiny("workers=1"))
+    two = run(tiny("workers=2"))
+    dask = run(tiny(), cluster)
+    assert one == two == dask
+
+
+def test_backend_from_the_configuration_starts_and_stops_a_local_cluster():
+    local = run(tiny(generations=2))
+    trainer = Trainer(tiny("backend=dask", "dask_workers=1", generations=2))
+    try:
+        assert isinstance(trainer.evaluator, DaskEvaluator)
+        assert len(trainer.evaluator.worker_pids()) == 1
+        rows = [trainer.run_generation() for _ in range(2)]
+    finally:
+        trainer.close()
+    assert [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows] == local[0]
+
+
+def test_a_worker_killed_mid_generation_costs_time_not_the_run(cluster):
+    want = run(tiny())
+    client = cluster.client
+    real_gather = client.gather
+    killed = []
+
+    def gather_after_killing(futures, *args, **kwargs):
+        # the generation's batches are submitted: kill one worker process while they run
+        if len(killed) < 2:
+            pid = sorted(cluster.worker_pids().values())[0]
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+        return real_gather(futures, *args, **kwargs)
+
+    client.gather = gather_after_killing
+    try:
+        got = run(tiny(), cluster)
+    finally:
+        del client.gather
+    assert len(killed) == 2 and cluster.lost is None
+    assert got == want
+    client.wait_for_workers(2, timeout=60)
+    assert not set(killed) & set(cluster.worker_pids().values())  # the nanny replaced them

@@ -114,3 +114,77 @@ def test_a_worker_killed_mid_generation_costs_time_not_the_run(cluster):
     assert got == want
     client.wait_for_workers(2, timeout=60)
     assert not set(killed) & set(cluster.worker_pids().values())  # the nanny replaced them
+
+
+def free_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for_port(port, seconds=60):
+    import socket
+    import time
+
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        with socket.socket() as s:
+            if s.connect_ex(("127.0.0.1", port)) == 0:
+                return
+        time.sleep(0.2)
+    raise TimeoutError(f"nothing listens on port {port}")
+
+
+@pytest.mark.slow  # a scheduler and a worker as separate processes: about 20 s
+def test_a_lost_scheduler_stops_the_run_at_a_generation_boundary():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from mtpg.engine.evaluator import BackendLost, LocalEvaluator
+
+    want = run(tiny())
+    dask = str(Path(sys.executable).parent / "dask")
+    address = f"tcp://127.0.0.1:{free_port()}"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    scheduler = subprocess.Popen(
+        [dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1]]
+        + ["--no-dashboard"],
+        **quiet,
+    )
+    worker = subprocess.Popen(
+        [dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
+        + ["--death-timeout", "5"],
+        **quiet,
+    )
+    try:
+        wait_for_port(int(address.rsplit(":", 1)[1]))
+        # the timeout also bounds reconnecting: the scheduler counts as lost after 5 s
+        ev = DaskEvaluator(address, min_roots=1, timeout=5)
+        ev.client.wait_for_workers(1, timeout=60)
+        trainer = Trainer(tiny())
+        trainer.evaluator = ev
+        rows = [trainer.run_generation()]
+        scheduler.kill()
+        scheduler.wait()
+        rows.append(trainer.run_generation())  # finished on this machine's threads
+        assert ev.lost is not None
+        with pytest.raises(BackendLost, match="lost the dask cluster"):
+            trainer.run_generation()
+        assert trainer.state.generation == 2  # nothing of generation 3 happened
+        trainer.evaluator = LocalEvaluator(1)  # as a resumed run on another backend would
+        while not trainer.done:
+            rows.append(trainer.run_generation())
+        ev.close()
+    finally:
+        worker.terminate()  # the nanny stops its worker process
+        try:
+            worker.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            worker.kill()
+        scheduler.kill()
+        scheduler.wait()
+    got = [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows]
+    assert got == want[0]

@@ -30,6 +30,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, help="run seed")
     p.add_argument("--workers", type=int, help="threads evaluating episodes")
     p.add_argument(
+        "--backend",
+        choices=("local", "dask"),
+        help="evaluate on this machine's threads (local) or a Dask cluster (dask)",
+    )
+    p.add_argument("--address", metavar="TCP://HOST:PORT", help="scheduler of a Dask cluster")
+    p.add_argument(
+        "--dask-workers", type=int, metavar="N", help="start a local Dask cluster of N processes"
+    )
+    p.add_argument(
         "--set",
         action="append",
         default=[],
@@ -55,9 +64,12 @@ def overrides(args: argparse.Namespace) -> list[str]:
     if args.tasks:
         names = [t.strip() for t in args.tasks.split(",") if t.strip()]
         out.append("evaluation.tasks=[" + ", ".join(f'"{t}"' for t in names) + "]")
-    for key in ("generations", "seed", "workers"):
+    for key in ("generations", "seed", "workers", "dask_workers"):
         if getattr(args, key) is not None:
             out.append(f"{key}={getattr(args, key)}")
+    for key in ("backend", "address"):
+        if getattr(args, key) is not None:
+            out.append(f'{key}="{getattr(args, key)}"')
     for dest, name in ABLATION_FLAGS.items():
         if getattr(args, dest):
             key, value = ABLATIONS[name]
@@ -84,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.cli.progress import Progress
     from mtpg.config import build_config, merge, parse_override
+    from mtpg.engine.evaluator import BackendLost
     from mtpg.evolve.session import Session, read_run_config
 
     if args.resume:
@@ -113,5 +126,13 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 130
+    except BackendLost as exc:
+        if progress:
+            progress.close()
+        print(
+            f"mtpg train: {exc}; resume with: mtpg train --resume {session.run.path}",
+            file=sys.stderr,
+        )
+        return 3
     print(f"done: {session.run.path}", file=sys.stderr)
     return 0

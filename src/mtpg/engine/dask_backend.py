@@ -26,6 +26,7 @@ import sys
 
 import numpy as np
 
+from mtpg.config import ConfigError
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.evaluator import BackendLost
@@ -129,7 +130,9 @@ class DaskEvaluator:
             try:
                 self.client = Client(address, timeout=timeout)
             except OSError as exc:
-                raise BackendLost(f"cannot reach the dask scheduler at {address}: {exc}") from exc
+                raise ConfigError(
+                    f"run.address: cannot reach the dask scheduler at {address}: {exc}"
+                ) from exc
         else:
             if n_workers < 1:
                 raise ValueError(f"dask workers must be >= 1, got {n_workers}")

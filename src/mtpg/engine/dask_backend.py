@@ -1,9 +1,10 @@
 """The ``dask`` evaluation backend: batches of roots on the workers of a Dask cluster.
 
-Per evaluation the compiled population and the episode table travel once to every worker
-as plain NumPy arrays (``Client.scatter`` with ``broadcast=True``); the jobs (root x
-episode) are dealt round-robin into about :data:`TASKS_PER_THREAD` batches per worker
-thread, each batch one task that runs the serial compiled kernel of
+Per evaluation the compiled population travels once to every worker as plain NumPy arrays
+(``Client.scatter`` with ``broadcast=True``), and so does each episode table, once per run
+(the training table is the same every generation); the jobs (root x episode) are dealt
+round-robin into about :data:`TASKS_PER_THREAD` batches per worker thread, each batch one
+task that runs the serial compiled kernel of
 :mod:`mtpg.engine.kernels` (importable, ``cache=True``: each worker process compiles or
 loads the kernels once, on its first task), and the outcomes are put back in job order.
 Results are bit-identical to the local backend's.
@@ -41,6 +42,8 @@ MIN_ROOTS_PER_BATCH = 8
 #: Times an evaluation is sent again when the cluster lost its inputs or results (while
 #: the scheduler is still there) before it counts as lost.
 RESUBMITS = 3
+#: Episode tables kept on the cluster between evaluations (training and test tables).
+TABLES_KEPT = 4
 #: Seconds to wait for a scheduler or for the workers of a new local cluster.
 CONNECT_TIMEOUT = 30
 
@@ -125,6 +128,7 @@ class DaskEvaluator:
         self.min_roots = min_roots
         self.lost: str | None = None
         self.resubmits = 0
+        self._tables: dict = {}
         self.cluster = None
         if address:
             try:
@@ -200,15 +204,14 @@ class DaskEvaluator:
     def _map(self, cp, job_roots, job_eps, episodes, no_memory) -> list:
         n_batches = plan_batches(len(job_roots), len(episodes.tasks), self.threads, self.min_roots)
         [graph] = self.client.scatter([graph_arrays(cp)], broadcast=True, hash=False)
-        table = (episodes.tasks, episodes.starts, episodes.noise)
-        [table_f] = self.client.scatter([table], broadcast=True, hash=False)
+        table = self._table(episodes)
         futures = [
             self.client.submit(
                 play_batch,
                 graph,
                 job_roots[b::n_batches],
                 job_eps[b::n_batches],
-                table_f,
+                table,
                 no_memory,
                 pure=False,
             )
@@ -216,9 +219,22 @@ class DaskEvaluator:
         ]
         try:
             return self.client.gather(futures)
+        except Exception:
+            self._tables.clear()  # its copies may have died with the workers: send again
+            raise
         finally:
-            for f in (*futures, graph, table_f):
+            for f in (*futures, graph):
                 f.release()
+
+    def _table(self, episodes: Episodes):
+        """The cluster's copy of an episode table, sent once per run and table."""
+        key = (episodes.tasks.tobytes(), episodes.seeds.tobytes())
+        if key not in self._tables:
+            if len(self._tables) >= TABLES_KEPT:
+                self._tables.pop(next(iter(self._tables))).release()
+            arrays = (episodes.tasks, episodes.starts, episodes.noise)
+            [self._tables[key]] = self.client.scatter([arrays], broadcast=True, hash=False)
+        return self._tables[key]
 
     def check(self) -> None:
         """Raises :class:`BackendLost` once the cluster was lost (at a generation boundary)."""

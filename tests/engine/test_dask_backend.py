@@ -79,16 +79,24 @@ def test_training_on_dask_equals_local_threads(cluster):
     assert one == two == dask
 
 
-def test_backend_from_the_configuration_starts_and_stops_a_local_cluster():
-    local = run(tiny(generations=2))
-    trainer = Trainer(tiny("backend=dask", "dask_workers=1", generations=2))
-    try:
-        assert isinstance(trainer.evaluator, DaskEvaluator)
-        assert len(trainer.evaluator.worker_pids()) == 1
-        rows = [trainer.run_generation() for _ in range(2)]
-    finally:
-        trainer.close()
-    assert [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows] == local[0]
+def test_train_command_on_a_local_cluster_writes_the_local_run(tmp_path):
+    import csv
+
+    from mtpg.cli.main import main
+
+    def train(out, *extra):
+        args = ["train", "--preset", "paper", "--generations", "3", "--out", str(out)]
+        args += [f"--set={o}" for o in TINY] + ["--set=evaluation.test_interval=2", "--quiet"]
+        assert main([*args, *extra]) == 0
+        with open(out / "metrics.csv") as fh:
+            rows = [
+                {k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in csv.DictReader(fh)
+            ]
+        return rows, (out / "tests.csv").read_text()
+
+    local = train(tmp_path / "local", "--workers", "2")
+    dask = train(tmp_path / "dask", "--backend", "dask", "--dask-workers", "1")
+    assert local == dask and len(local[0]) == 3
 
 
 def test_a_worker_killed_mid_generation_costs_time_not_the_run(cluster):

@@ -134,5 +134,7 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 3
+    finally:
+        session.trainer.close()  # stops a local Dask cluster started for the run
     print(f"done: {session.run.path}", file=sys.stderr)
     return 0

@@ -10,7 +10,9 @@ runs must agree on every non-timing metric, which the script checks.
 
 ``local:N`` is the local backend on N threads; ``dask:N`` starts a local Dask cluster of
 N one-thread worker processes on the loopback interface (dashboard off). Measure on an
-otherwise idle machine; the last line is one JSON object with every figure.
+otherwise idle machine (the CPU seconds, summed over the driver and the local worker
+processes, show the backend's overhead even on a busy one); the last line is one JSON
+object with every figure.
 """
 
 from __future__ import annotations
@@ -25,6 +27,20 @@ from mtpg.config import build_config
 from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
 
 
+def tree_cpu() -> float:
+    """CPU seconds used so far by this process and its children (the local workers)."""
+    import psutil
+
+    me = psutil.Process()
+    total = sum(me.cpu_times()[:2])
+    for child in me.children(recursive=True):
+        try:
+            total += sum(child.cpu_times()[:2])
+        except psutil.Error:
+            pass
+    return total
+
+
 def run(spec: str, generations: int, seed: int, extra: list[str]) -> tuple[list, list]:
     kind, n = spec.split(":")
     overrides = [f"generations={generations}", f"seed={seed}", *extra]
@@ -33,13 +49,16 @@ def run(spec: str, generations: int, seed: int, extra: list[str]) -> tuple[list,
     else:
         overrides += ["backend=dask", f"dask_workers={n}", "workers=2"]
     trainer = Trainer(build_config("paper", overrides=overrides))
-    rows = []
+    rows, cpu = [], []
     try:
         while not trainer.done:
+            before = tree_cpu()
             rows.append(trainer.run_generation())
+            cpu.append(tree_cpu() - before)
     finally:
         trainer.close()
-    timing = [(r["decisions_per_s"], r["t_total"]) for r in rows[1:]]
+    timing = [(r["decisions_per_s"], r["t_total"], c) for r, c in zip(rows, cpu, strict=True)]
+    timing = timing[1:]
     same = [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows]
     return timing, same
 
@@ -60,8 +79,13 @@ def main() -> None:
             raise SystemExit(f"{spec}: metrics differ from {args.backends[0]}'s")
         dps = statistics.median(t[0] for t in timing)
         gen = statistics.median(t[1] for t in timing)
-        results[spec] = {"decisions_per_s": dps, "generation_s": gen}
-        print(f"{spec:10s} {dps:14,.0f} decisions/s  {gen:7.2f} s per generation", flush=True)
+        cpu = statistics.median(t[2] for t in timing)
+        results[spec] = {"decisions_per_s": dps, "generation_s": gen, "generation_cpu_s": cpu}
+        print(
+            f"{spec:10s} {dps:14,.0f} decisions/s  {gen:7.2f} s per generation"
+            f"  {cpu:7.2f} s CPU per generation (driver and local workers)",
+            flush=True,
+        )
     base = results.get("local:2")
     if base:
         for spec, r in results.items():

@@ -24,6 +24,7 @@ from __future__ import annotations
 import logging
 import os
 import sys
+import warnings
 
 import numpy as np
 
@@ -140,14 +141,18 @@ class DaskEvaluator:
         else:
             if n_workers < 1:
                 raise ValueError(f"dask workers must be >= 1, got {n_workers}")
-            self.cluster = LocalCluster(
-                n_workers=n_workers,
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                dashboard_address=None,
-                silence_logs=logging.ERROR,
-            )
+            with warnings.catch_warnings():
+                # with the dashboard off the scheduler still serves health checks over HTTP
+                # on loopback, on port 8787 or, when that is taken, on any free port
+                warnings.filterwarnings("ignore", message="Port .* is already in use")
+                self.cluster = LocalCluster(
+                    n_workers=n_workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    dashboard_address=None,
+                    silence_logs=logging.ERROR,
+                )
             self.client = Client(self.cluster, timeout=timeout)
             self.address = self.cluster.scheduler_address
         self.pids = self.client.run(warm_up)

@@ -145,54 +145,94 @@ def wait_for_port(port, seconds=60):
     raise TimeoutError(f"nothing listens on port {port}")
 
 
-@pytest.mark.slow  # a scheduler and a worker as separate processes: about 20 s
-def test_a_lost_scheduler_stops_the_run_at_a_generation_boundary():
-    import subprocess
-    import sys
-    from pathlib import Path
+class Cluster:
+    """A scheduler and one worker as separate processes (``dask scheduler``/``dask worker``)."""
 
-    from mtpg.engine.evaluator import BackendLost, LocalEvaluator
+    def __init__(self, port):
+        import subprocess
+        import sys
+        from pathlib import Path
 
-    want = run(tiny())
-    dask = str(Path(sys.executable).parent / "dask")
-    address = f"tcp://127.0.0.1:{free_port()}"
-    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
-    scheduler = subprocess.Popen(
-        [dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1]]
-        + ["--no-dashboard"],
-        **quiet,
-    )
-    worker = subprocess.Popen(
-        [dask, "worker", address, "--nworkers", "1", "--nthreads", "1", "--no-dashboard"]
-        + ["--death-timeout", "5"],
-        **quiet,
-    )
-    try:
-        wait_for_port(int(address.rsplit(":", 1)[1]))
-        # the timeout also bounds reconnecting: the scheduler counts as lost after 5 s
-        ev = DaskEvaluator(address, min_roots=1, timeout=5)
-        ev.client.wait_for_workers(1, timeout=60)
-        trainer = Trainer(tiny())
-        trainer.evaluator = ev
-        rows = [trainer.run_generation()]
-        scheduler.kill()
-        scheduler.wait()
-        rows.append(trainer.run_generation())  # finished on this machine's threads
-        assert ev.lost is not None
-        with pytest.raises(BackendLost, match="lost the dask cluster"):
-            trainer.run_generation()
-        assert trainer.state.generation == 2  # nothing of generation 3 happened
-        trainer.evaluator = LocalEvaluator(1)  # as a resumed run on another backend would
-        while not trainer.done:
-            rows.append(trainer.run_generation())
-        ev.close()
-    finally:
-        worker.terminate()  # the nanny stops its worker process
+        dask = str(Path(sys.executable).parent / "dask")
+        self.address = f"tcp://127.0.0.1:{port}"
+        quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+        self.scheduler = subprocess.Popen(
+            [dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+            **quiet,
+        )
+        self.worker = subprocess.Popen(
+            [dask, "worker", self.address, "--nworkers", "1", "--nthreads", "1"]
+            + ["--no-dashboard", "--death-timeout", "5"],
+            **quiet,
+        )
+        wait_for_port(port)
+
+    def kill_scheduler(self):
+        self.scheduler.kill()
+        self.scheduler.wait()
+
+    def stop(self):
+        import subprocess
+
+        self.worker.terminate()  # the nanny stops its worker process
         try:
-            worker.wait(timeout=20)
+            self.worker.wait(timeout=20)
         except subprocess.TimeoutExpired:
-            worker.kill()
-        scheduler.kill()
-        scheduler.wait()
-    got = [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows]
-    assert got == want[0]
+            self.worker.kill()
+            self.worker.wait()
+        self.kill_scheduler()
+
+
+@pytest.mark.slow  # schedulers and workers as separate processes: about a minute
+def test_a_lost_scheduler_stops_the_run_at_a_boundary_and_resume_continues_it(
+    tmp_path, monkeypatch
+):
+    import csv
+
+    import mtpg.engine.dask_backend as backend
+    from mtpg.engine.evaluator import BackendLost
+    from mtpg.evolve.session import Session
+    from mtpg.io.checkpoint import checkpoint_path
+
+    def metrics(run_dir):
+        with open(run_dir / "metrics.csv") as fh:
+            return [
+                {k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in csv.DictReader(fh)
+            ]
+
+    def champions(run_dir):
+        return {p.name: p.read_bytes() for p in sorted((run_dir / "champions").glob("*.json"))}
+
+    extra = ["evaluation.test_interval=2", "checkpoint_interval=10"]
+    Session(tmp_path / "local", tiny(*extra, generations=5)).run_all()
+    monkeypatch.setattr(backend, "CONNECT_TIMEOUT", 5)  # the scheduler counts as lost after 5 s
+    port = free_port()
+    config = tiny(*extra, "backend=dask", f'address="tcp://127.0.0.1:{port}"', generations=5)
+    first = Cluster(port)
+    try:
+        session = Session(tmp_path / "dask", config)
+        session.trainer.evaluator.client.wait_for_workers(1, timeout=60)
+
+        def kill_after_generation_1(row, trainer):
+            if row["generation"] == 1:
+                first.kill_scheduler()
+
+        with pytest.raises(BackendLost, match="lost the dask cluster"):
+            session.run_all(kill_after_generation_1)
+        session.trainer.close()
+    finally:
+        first.stop()
+    # generation 2 was finished on this machine and checkpointed; nothing of generation 3
+    assert len(metrics(tmp_path / "dask")) == 2
+    assert checkpoint_path(tmp_path / "dask", 2).exists()
+    assert not checkpoint_path(tmp_path / "dask", 3).exists()
+    second = Cluster(port)  # a new scheduler at the same address
+    try:
+        resumed = Session(tmp_path / "dask", config, resume=True)
+        assert resumed.trainer.state.generation == 2
+        resumed.run_all()
+        resumed.trainer.close()
+    finally:
+        second.stop()
+    assert metrics(tmp_path / "dask") == metrics(tmp_path / "local")
+    assert champions(tmp_path / "dask") == champions(tmp_path / "local")

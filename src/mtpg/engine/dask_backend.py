@@ -111,7 +111,7 @@ class DaskEvaluator:
             cluster was lost.
         min_roots: Fewest roots per batch.
         timeout: Seconds to wait for the scheduler (to connect, and to reconnect before it
-            counts as lost).
+            counts as lost); :data:`CONNECT_TIMEOUT` when None.
     """
 
     def __init__(
@@ -120,10 +120,11 @@ class DaskEvaluator:
         n_workers: int = 2,
         fallback_threads: int = 1,
         min_roots: int = MIN_ROOTS_PER_BATCH,
-        timeout: float = CONNECT_TIMEOUT,
+        timeout: float | None = None,
     ) -> None:
         from distributed import Client, LocalCluster
 
+        timeout = CONNECT_TIMEOUT if timeout is None else timeout
         self.address = address
         self.fallback_threads = fallback_threads
         self.min_roots = min_roots

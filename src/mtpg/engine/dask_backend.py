@@ -156,7 +156,14 @@ class DaskEvaluator:
                 )
             self.client = Client(self.cluster, timeout=timeout)
             self.address = self.cluster.scheduler_address
-        self.pids = self.client.run(warm_up)
+        try:
+            self.pids = self.client.run(warm_up)
+        except ImportError as exc:
+            self.close()
+            raise ConfigError(
+                f"run.address: the workers of {self.address} cannot import mtpg ({exc}); "
+                "install the same mtpg version on every worker"
+            ) from exc
 
     @property
     def threads(self) -> int:

@@ -186,6 +186,16 @@ class RunConfig:
     checkpoint_interval: int = 10
     """Generations between checkpoints (commits); one is also written when the run ends or
     is stopped by a signal, always of a complete generation (docs/runs.md)."""
+    backend: str = "local"
+    """Where new roots are evaluated: ``local`` (this machine's ``workers`` threads) or
+    ``dask`` (a Dask cluster: ``address``, or a local one of ``dask_workers`` processes).
+    Results do not depend on it."""
+    address: str = ""
+    """Scheduler address ``tcp://HOST:PORT`` of a running Dask cluster (backend ``dask``);
+    empty to start a local cluster of ``dask_workers`` processes."""
+    dask_workers: int = 0
+    """Worker processes of a local Dask cluster started for the run (backend ``dask`` and
+    no ``address``); 0 otherwise."""
     program: ProgramConfig = field(default_factory=ProgramConfig)
     """Program settings."""
     team: TeamConfig = field(default_factory=TeamConfig)
@@ -196,6 +206,12 @@ class RunConfig:
     def __post_init__(self) -> None:
         _positive(self, "run", ("seed", "generations"), minimum=0)
         _positive(self, "run", ("workers", "checkpoint_interval"))
+        _positive(self, "run", ("dask_workers",), minimum=0)
+        _check(
+            self.backend in ("local", "dask"), "run.backend", "must be local or dask", self.backend
+        )
+        # whether backend dask has an address or workers is checked when the run starts
+        # (mtpg.engine.evaluator.make_evaluator): overrides arrive one field at a time
 
     @property
     def elites_per_subset(self) -> int:
@@ -234,7 +250,9 @@ _SECTIONS = {"program": ProgramConfig, "team": TeamConfig, "evaluation": Evaluat
 
 def _coerce(name: str, ftype: Any, value: Any) -> Any:
     """Checks ``value`` against the field type; ints are accepted for floats."""
-    expected = {"int": int, "float": float, "bool": bool, "tuple[str, ...]": tuple}[str(ftype)]
+    expected = {"int": int, "float": float, "bool": bool, "str": str, "tuple[str, ...]": tuple}[
+        str(ftype)
+    ]
     if expected is float and isinstance(value, int) and not isinstance(value, bool):
         return float(value)
     if expected is tuple and isinstance(value, list | tuple):

@@ -103,16 +103,16 @@ def test_ablation_switches_change_exactly_what_they_name(switch, field, value):
 
 
 def test_no_memory_flag_reaches_the_engine(monkeypatch):
-    import mtpg.evolve.trainer as trainer_module
+    import mtpg.engine.evaluator as evaluator_module
 
     seen = []
-    real = trainer_module.evaluate_roots
+    real = evaluator_module.evaluate_roots
 
     def spy(*args, **kwargs):
         seen.append(args[4] if len(args) > 4 else kwargs["no_memory"])
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(trainer_module, "evaluate_roots", spy)
+    monkeypatch.setattr(evaluator_module, "evaluate_roots", spy)
     run_rows(tiny("evaluation.no_memory=true", generations=2))
     run_rows(tiny(generations=2))
     assert seen == [True, True, False, False]

@@ -64,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     Returns:
         0.
     """
-    from mtpg.engine.bench import benchmark
+    from mtpg.bench.engine import benchmark
 
     def log(msg: str) -> None:
         print(msg, flush=True)

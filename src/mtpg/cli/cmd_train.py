@@ -29,6 +29,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, help="run seed")
     p.add_argument("--workers", type=int, help="threads evaluating episodes")
     p.add_argument(
+        "--backend",
+        choices=("local", "dask"),
+        help="evaluate on this machine's threads (local) or a Dask cluster (dask)",
+    )
+    p.add_argument("--address", metavar="TCP://HOST:PORT", help="scheduler of a Dask cluster")
+    p.add_argument(
+        "--dask-workers", type=int, metavar="N", help="start a local Dask cluster of N processes"
+    )
+    p.add_argument(
         "--set",
         action="append",
         default=[],
@@ -65,9 +74,12 @@ def overrides(args: argparse.Namespace) -> list[str]:
     if args.tasks is not None:
         names = task_list(args.tasks)
         out.append("evaluation.tasks=[" + ", ".join(f'"{t}"' for t in names) + "]")
-    for key in ("generations", "seed", "workers"):
+    for key in ("generations", "seed", "workers", "dask_workers"):
         if getattr(args, key) is not None:
             out.append(f"{key}={getattr(args, key)}")
+    for key in ("backend", "address"):
+        if getattr(args, key) is not None:
+            out.append(f'{key}="{getattr(args, key)}"')
     for dest, name in ABLATION_FLAGS.items():
         if getattr(args, dest):
             key, value = ABLATIONS[name]
@@ -96,8 +108,21 @@ def run(args: argparse.Namespace) -> int:
     """
     from mtpg.cli.progress import Progress
     from mtpg.config import build_config, merge_overrides
+    from mtpg.engine.evaluator import BackendLost
     from mtpg.evolve.session import Session, read_run_config
     from mtpg.evolve.stopping import GracefulStop, StopNow, exit_code
+
+    lost: list[BackendLost] = []
+
+    def should_stop() -> bool:  # a signal, or a lost cluster: stop at this boundary
+        if stop.requested():
+            return True
+        try:
+            session.trainer.evaluator.check()
+        except BackendLost as exc:
+            lost.append(exc)
+            return True
+        return False
 
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
@@ -115,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
         )
         progress = None if args.quiet else Progress.for_session(session)
         try:
-            finished = session.run_all(progress, stop.requested)
+            finished = session.run_all(progress, should_stop)
         except StopNow as exc:
             if progress:
                 progress.close()
@@ -126,14 +151,17 @@ def run(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return exit_code(exc.signum)
-    if not finished and stop.signum is not None:
+        finally:
+            session.trainer.close()  # stops a local Dask cluster started for the run
+    if not finished and (lost or stop.signum is not None):
         if progress:
             progress.close()
+        why = f"lost the evaluation backend ({lost[0]})" if lost else f"stopped by {stop.name}"
         print(
-            f"stopped by {stop.name} after generation {session.saved_generation} (committed); "
+            f"{why} after generation {session.saved_generation} (committed); "
             f"resume with: mtpg train --resume {where}",
             file=sys.stderr,
         )
-        return exit_code(stop.signum)
+        return 1 if lost else exit_code(stop.signum)
     print(f"done: {where}", file=sys.stderr)
     return 0

@@ -133,7 +133,7 @@ def decide(
         team = act
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def run_jobs_strided(
     chunk,
     n_chunks,
@@ -159,6 +159,8 @@ def run_jobs_strided(
     base,
 ):  # noqa: N803
     """Runs jobs ``chunk, chunk + n_chunks, ...`` serially with one private workspace.
+
+    Releases the GIL, so several Python threads (e.g. of one Dask worker) run it at once.
 
     Job ``j`` plays episode ``job_ep[j]`` (task ``ep_task``, start state ``ep_start`` and
     noise ``ep_noise`` rows) with root ``job_root[j]`` and writes its return, steps,

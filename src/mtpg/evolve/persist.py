@@ -20,7 +20,14 @@ from mtpg.evolve.trainer import TrainerState
 from mtpg.io.serialize import FormatError, population_from_dict, population_to_dict
 
 #: Settings a resumed run may change: they do not alter what the run computes.
-RESUMABLE_CHANGES = ("generations", "workers", "checkpoint_interval")
+RESUMABLE_CHANGES = (
+    "generations",
+    "workers",
+    "checkpoint_interval",
+    "backend",
+    "address",
+    "dask_workers",
+)
 
 
 def identity_fields(config: RunConfig) -> dict[str, Any]:

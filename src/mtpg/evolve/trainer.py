@@ -12,8 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from mtpg.config import RunConfig
-from mtpg.engine.batch import Episodes, evaluate_roots
+from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
+from mtpg.engine.evaluator import make_evaluator
 from mtpg.envs.core import TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds, training_seeds
 from mtpg.evolve.selection import select, task_subsets
@@ -105,6 +106,11 @@ class Trainer:
         self.subsets = task_subsets(len(self.task_ids))
         seeds = training_seeds(ev.train_episodes)
         self.episodes = Episodes.grid(self.task_ids, seeds)
+        self.evaluator = make_evaluator(config)
+
+    def close(self) -> None:
+        """Releases the evaluation backend (a Dask cluster started for the run)."""
+        self.evaluator.close()
 
     @property
     def done(self) -> bool:
@@ -127,6 +133,7 @@ class Trainer:
         are at least as many banks as teams.
         """
         st, cfg = self.state, self.config
+        self.evaluator.check()  # a lost cluster stops the run here, between generations
         gen = st.generation + 1
         t0 = time.perf_counter()
         if gen == 1:
@@ -168,7 +175,7 @@ class Trainer:
         roots = sorted(set(st.champions))
         table = Episodes.grid(self.task_ids, held_out_seeds(ev.test_episodes))
         cp = compile_population(st.population)
-        returns, result = evaluate_roots(cp, roots, table, self.config.workers, ev.no_memory)
+        returns, result = self.evaluator.evaluate(cp, roots, table, ev.no_memory)
         n = len(self.task_ids)
         means = returns.reshape(len(roots), n, ev.test_episodes).mean(axis=2)
         per_root = result.teams.reshape(len(roots), -1).sum(axis=1)
@@ -205,8 +212,8 @@ class Trainer:
         st = self.state
         new_roots = [r for r in st.population.roots() if r not in st.scores]
         cp = compile_population(st.population)
-        returns, result = evaluate_roots(
-            cp, new_roots, self.episodes, self.config.workers, self.config.evaluation.no_memory
+        returns, result = self.evaluator.evaluate(
+            cp, new_roots, self.episodes, self.config.evaluation.no_memory
         )
         n_ep = self.config.evaluation.train_episodes
         means = returns.reshape(len(new_roots), len(self.task_ids), n_ep).mean(axis=2)

@@ -15,6 +15,41 @@ from mtpg.config import ProgramConfig, RunConfig, TeamConfig
 from mtpg.model.graph import N_ACTIONS, Population, atomic
 from mtpg.model.instructions import RegisterLayout, random_instructions
 
+#: Random instructions drawn at once by an :class:`InstructionPool` (part of the run's
+#: definition: changing it changes the random stream).
+POOL_BLOCK = 1024
+
+
+class InstructionPool:
+    """Random instructions drawn from ``rng`` in blocks, handed out in order.
+
+    Each row is an independent draw of :func:`~mtpg.model.instructions.random_instructions`,
+    so the distribution is unchanged; drawing a block of :data:`POOL_BLOCK` costs about
+    what drawing one instruction does, which makes variation cheap. The generator is
+    advanced only when a block is drawn, so the stream stays a function of the seed.
+
+    Args:
+        rng: The generator to draw from.
+        layout: Register sizes.
+    """
+
+    def __init__(self, rng: np.random.Generator, layout: RegisterLayout) -> None:
+        self.rng = rng
+        self.layout = layout
+        self.block = np.zeros((0, 4), np.int32)
+        self.at = 0
+
+    def take(self, n: int) -> np.ndarray:
+        """The next ``n`` instructions, int32 ``(n, 4)`` (a fresh array)."""
+        if self.at + n > len(self.block):
+            rest = self.block[self.at :]
+            new = random_instructions(self.rng, self.layout, max(POOL_BLOCK, n - len(rest)))
+            self.block = np.concatenate([rest, new])
+            self.at = 0
+        out = self.block[self.at : self.at + n].copy()
+        self.at += n
+        return out
+
 
 def init_population(config: RunConfig, rng: np.random.Generator) -> Population:
     """Creates ``root_size`` root teams of ``init_team_size`` new atomic programs each.
@@ -24,11 +59,12 @@ def init_population(config: RunConfig, rng: np.random.Generator) -> Population:
     """
     layout = RegisterLayout(config.program.n_registers, config.program.n_memory)
     pop = Population(layout=layout)
+    pool = InstructionPool(rng, layout)
     for _ in range(config.team.root_size):
         pids = []
         for _ in range(config.team.init_team_size):
             length = int(rng.integers(1, config.program.init_max_length + 1))
-            code = random_instructions(rng, layout, length)
+            code = pool.take(length)
             action = atomic(int(rng.integers(0, N_ACTIONS)))
             pids.append(pop.add_program(code, action, pop.new_bank()).id)
         pop.add_team(pids, birth=0)
@@ -36,31 +72,44 @@ def init_population(config: RunConfig, rng: np.random.Generator) -> Population:
 
 
 def mutate_code(
-    code: np.ndarray, cfg: ProgramConfig, layout: RegisterLayout, rng: np.random.Generator
+    code: np.ndarray,
+    cfg: ProgramConfig,
+    layout: RegisterLayout,
+    rng: np.random.Generator,
+    pool: InstructionPool | None = None,
 ) -> np.ndarray:
     """Returns a mutated copy of a program's instructions.
 
     Four independent trials: delete a random instruction (``p_delete``, kept >= 1 long),
     insert a random instruction (``p_add``, up to ``max_length``), change one field of one
     instruction to a different valid value (``p_mutate``), swap two instructions
-    (``p_swap``).
+    (``p_swap``). New instructions and field values come from ``pool`` (a fresh one on
+    ``rng`` when None).
     """
-    code = code.copy()
-    if rng.random() < cfg.p_delete and len(code) > 1:
-        code = np.delete(code, int(rng.integers(0, len(code))), axis=0)
-    if rng.random() < cfg.p_add and len(code) < cfg.max_length:
-        at = int(rng.integers(0, len(code) + 1))
-        code = np.insert(code, at, random_instructions(rng, layout, 1)[0], axis=0)
+    pool = pool or InstructionPool(rng, layout)
+    n = len(code)
+    if rng.random() < cfg.p_delete and n > 1:
+        k = int(rng.integers(0, n))
+        code = np.concatenate([code[:k], code[k + 1 :]])
+    else:
+        code = code.copy()
+    n = len(code)
+    if rng.random() < cfg.p_add and n < cfg.max_length:
+        at = int(rng.integers(0, n + 1))
+        code = np.concatenate([code[:at], pool.take(1), code[at:]])
+    n = len(code)
     if rng.random() < cfg.p_mutate:
-        k = int(rng.integers(0, len(code)))
+        k = int(rng.integers(0, n))
         column = int(rng.integers(0, 4))
         for _ in range(16):  # redraw until the field changes (always possible for op)
-            fresh = random_instructions(rng, layout, 1)[0]
-            if fresh[column] != code[k, column]:
-                code[k, column] = fresh[column]
+            fresh = int(pool.take(1)[0, column])
+            if fresh != code[k, column]:
+                code[k, column] = fresh
                 break
-    if rng.random() < cfg.p_swap and len(code) > 1:
-        i, j = rng.choice(len(code), size=2, replace=False)
+    if rng.random() < cfg.p_swap and n > 1:
+        i = int(rng.integers(0, n))
+        j = int(rng.integers(0, n - 1))
+        j += j >= i  # two distinct positions, uniformly
         code[[i, j]] = code[[j, i]]
     return code
 
@@ -87,6 +136,7 @@ class Varier:
         self.targets = [tid for tid, t in pop.teams.items() if t.birth < generation]
         self.program_pool = list(pop.programs)
         self.banks = pop.banks()  # the whole bank population, ascending, fresh banks included
+        self.pool = InstructionPool(rng, pop.layout)
 
     def child(self, parent1: int, parent2: int) -> int:
         """Creates one new root team from two parents and returns its id."""
@@ -157,7 +207,7 @@ class Varier:
     def _mutated_copy(self, progs: list[int], k: int) -> int:
         """Replaces ``progs[k]`` by a mutated copy; returns the copy's id."""
         rng, old = self.rng, self.pop.programs[progs[k]]
-        code = mutate_code(old.instructions, self.pcfg, self.pop.layout, rng)
+        code = mutate_code(old.instructions, self.pcfg, self.pop.layout, rng, self.pool)
         action, bank = old.action, old.bank
         if rng.random() < self.cfg.p_action:
             last_atomic = action < 0 and sum(self._is_atomic(q) for q in progs) == 1

@@ -1,6 +1,6 @@
 """The engine benchmark behind ``mtpg bench engine``: baselines and the summary.
 
-The workload and the compiled driver live in :mod:`mtpg.engine.bench_workload`. Besides
+The workload and the compiled driver live in :mod:`mtpg.bench.workload`. Besides
 the compiled engine, two baselines are timed on the first graphs of the workload: the
 plain-Python reference interpreter (its actions are checked against the compiled run, so
 both play the very same episodes) and, when installed, the ``pytpg`` package on graphs of
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from mtpg.engine.bench_workload import Workload, drive, episode_row, make_workload, warm_up
+from mtpg.bench.workload import Workload, drive, episode_row, make_workload, warm_up
 from mtpg.engine.reference import ReferenceAgent
 from mtpg.envs import CARTPOLE, TASK_PARAMS, env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE

@@ -1,4 +1,4 @@
-"""The engine benchmark's workload and its compiled driver (see :mod:`mtpg.engine.bench`).
+"""The engine benchmark's workload and its compiled driver (see :mod:`mtpg.bench.engine`).
 
 A fixed, seeded workload: ``graphs`` independent random graphs (``teams`` x ``programs``
 x ``instructions``, about 40% of programs pointing to a later team, one memory bank per

@@ -1,0 +1,1 @@
+"""Benchmarks: the engine benchmark behind ``mtpg bench engine`` and its workload."""

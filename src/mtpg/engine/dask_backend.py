@@ -1,0 +1,278 @@
+"""The ``dask`` evaluation backend: batches of roots on the workers of a Dask cluster.
+
+Per evaluation the compiled population travels once to every worker as plain NumPy arrays
+(``Client.scatter`` with ``broadcast=True``), and so does each episode table, once per run
+(the training table is the same every generation); the jobs (root x episode) are dealt
+round-robin into about :data:`TASKS_PER_THREAD` batches per worker thread, each batch one
+task that runs the serial compiled kernel of
+:mod:`mtpg.engine.kernels` (importable, ``cache=True``: each worker process compiles or
+loads the kernels once, on its first task), and the outcomes are put back in job order.
+Results are bit-identical to the local backend's.
+
+Faults. A worker that dies mid-evaluation costs time only: Dask recomputes its batches on
+the other workers (evaluation is pure); should every copy of the inputs die with workers,
+the evaluation is sent again (up to :data:`RESUBMITS` times). A lost scheduler (or a batch
+that keeps killing workers) cannot be recovered from inside the cluster; the evaluation in
+progress is then finished on this machine's threads, so the generation completes with the
+very same result, and :meth:`DaskEvaluator.check` raises
+:class:`~mtpg.engine.evaluator.BackendLost` before the next generation starts: the run
+stops cleanly at a generation boundary and ``mtpg train --resume`` continues it.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+import warnings
+
+import numpy as np
+
+from mtpg.config import ConfigError
+from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
+from mtpg.engine.compile import CompiledPopulation
+from mtpg.engine.evaluator import BackendLost
+from mtpg.engine.kernels import run_jobs_strided
+from mtpg.envs import TASK_PARAMS
+
+#: Batches per worker thread: enough to balance episodes of uneven cost, few enough that
+#: the scheduler's cost per task (about 1.5 ms) stays negligible.
+TASKS_PER_THREAD = 4
+#: Fewest roots per batch (smaller evaluations use fewer batches).
+MIN_ROOTS_PER_BATCH = 8
+#: Times an evaluation is sent again when the cluster lost its inputs or results (while
+#: the scheduler is still there) before it counts as lost.
+RESUBMITS = 3
+#: Episode tables kept on the cluster between evaluations (training and test tables).
+TABLES_KEPT = 4
+#: Seconds to wait for a scheduler or for the workers of a new local cluster.
+CONNECT_TIMEOUT = 30
+
+
+def graph_arrays(cp: CompiledPopulation) -> tuple:
+    """The compiled graph as the kernels take it: arrays and three ints, no model objects."""
+    return cp.kernel_args()
+
+
+def play_batch(
+    graph: tuple,
+    job_roots: np.ndarray,
+    job_eps: np.ndarray,
+    table: tuple[np.ndarray, np.ndarray, np.ndarray],
+    no_memory: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Plays one batch of jobs serially (runs on a worker).
+
+    Args:
+        graph: :func:`graph_arrays` of the compiled population.
+        job_roots: int64 dense team index of each job.
+        job_eps: int64 episode row of each job.
+        table: The episode table's ``tasks``, ``starts`` and ``noise`` arrays.
+        no_memory: The memory ablation switch.
+
+    Returns:
+        ``returns, steps, teams, instructions`` of the batch's jobs, in order.
+    """
+    n = len(job_roots)
+    out = (np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
+    run_jobs_strided(0, 1, job_roots, job_eps, *table, TASK_PARAMS, no_memory, *out, *graph)
+    return out
+
+
+def warm_up() -> int:
+    """Loads (or compiles) the kernels in a worker process; returns its pid."""
+    from mtpg.engine.compile import compile_population
+    from mtpg.engine.workload import layered_graphs
+
+    pop, roots = layered_graphs(np.random.default_rng(0), 1, teams=2, programs=2, instructions=2)
+    evaluate_roots(compile_population(pop), roots, Episodes.grid([0], [0]))
+    return os.getpid()
+
+
+def plan_batches(n_jobs: int, jobs_per_root: int, threads: int, min_roots: int) -> int:
+    """Number of batches for ``n_jobs`` jobs on a cluster with ``threads`` worker threads.
+
+    About :data:`TASKS_PER_THREAD` batches per thread, but each with at least
+    ``min_roots`` roots' worth of jobs, and at least one batch.
+    """
+    most = max(1, n_jobs // max(1, jobs_per_root * min_roots))
+    return max(1, min(TASKS_PER_THREAD * max(1, threads), most, n_jobs))
+
+
+class DaskEvaluator:
+    """Evaluates batches of roots on a Dask cluster.
+
+    Args:
+        address: Scheduler address (``tcp://HOST:PORT``) of a running cluster, or None to
+            start a local cluster on the loopback interface.
+        n_workers: Worker processes of the local cluster (one thread each); ignored with
+            ``address``.
+        fallback_threads: Threads used on this machine to finish an evaluation whose
+            cluster was lost.
+        min_roots: Fewest roots per batch.
+        timeout: Seconds to wait for the scheduler (to connect, and to reconnect before it
+            counts as lost); :data:`CONNECT_TIMEOUT` when None.
+    """
+
+    def __init__(
+        self,
+        address: str | None = None,
+        n_workers: int = 2,
+        fallback_threads: int = 1,
+        min_roots: int = MIN_ROOTS_PER_BATCH,
+        timeout: float | None = None,
+    ) -> None:
+        from distributed import Client, LocalCluster
+
+        timeout = CONNECT_TIMEOUT if timeout is None else timeout
+        self.address = address
+        self.fallback_threads = fallback_threads
+        self.min_roots = min_roots
+        self.lost: str | None = None
+        self.resubmits = 0
+        self._tables: dict = {}
+        self.cluster = None
+        if address:
+            try:
+                self.client = Client(address, timeout=timeout)
+            except OSError as exc:
+                raise ConfigError(
+                    f"run.address: cannot reach the dask scheduler at {address}: {exc}"
+                ) from exc
+        else:
+            if n_workers < 1:
+                raise ValueError(f"dask workers must be >= 1, got {n_workers}")
+            with warnings.catch_warnings():
+                # with the dashboard off the scheduler still serves health checks over HTTP
+                # on loopback, on port 8787 or, when that is taken, on any free port
+                warnings.filterwarnings("ignore", message="Port .* is already in use")
+                self.cluster = LocalCluster(
+                    n_workers=n_workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    dashboard_address=None,
+                    silence_logs=logging.ERROR,
+                )
+            self.client = Client(self.cluster, timeout=timeout)
+            self.address = self.cluster.scheduler_address
+        try:
+            self.pids = self.client.run(warm_up)
+        except ImportError as exc:
+            self.close()
+            raise ConfigError(
+                f"run.address: the workers of {self.address} cannot import mtpg ({exc}); "
+                "install the same mtpg version on every worker"
+            ) from exc
+
+    @property
+    def threads(self) -> int:
+        """Worker threads in the cluster now."""
+        return int(sum(self.client.nthreads().values()))
+
+    def worker_pids(self) -> dict[str, int]:
+        """Process id of every worker, by worker address."""
+        return self.client.run(os.getpid)
+
+    def evaluate(
+        self,
+        cp: CompiledPopulation,
+        root_ids: list[int],
+        episodes: Episodes,
+        no_memory: bool = False,
+    ) -> tuple[np.ndarray, BatchResult]:
+        """See :meth:`mtpg.engine.evaluator.Evaluator.evaluate`."""
+        if self.lost is not None:
+            return evaluate_roots(cp, root_ids, episodes, self.fallback_threads, no_memory)
+        roots = np.array([cp.team_index(r) for r in root_ids], dtype=np.int64)
+        n_ep = len(episodes.tasks)
+        job_roots = np.repeat(roots, n_ep)
+        job_eps = np.tile(np.arange(n_ep, dtype=np.int64), len(roots))
+        for attempt in range(RESUBMITS + 1):
+            try:
+                parts = self._map(cp, job_roots, job_eps, episodes, no_memory)
+                break
+            except Exception as exc:  # noqa: BLE001 - a cluster failure: retry, else local
+                if not _is_cluster_failure(exc):
+                    raise
+                if attempt < RESUBMITS and self.client.status == "running":
+                    self.resubmits += 1
+                    continue  # e.g. every copy of the inputs died with workers: send again
+                self.lost = f"{type(exc).__name__}: {exc}".strip().splitlines()[0]
+                return evaluate_roots(cp, root_ids, episodes, self.fallback_threads, no_memory)
+        n = len(job_roots)
+        result = BatchResult(
+            np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64)
+        )
+        n_batches = len(parts)
+        for b, part in enumerate(parts):
+            for column, values in zip(
+                (result.returns, result.steps, result.teams, result.instructions),
+                part,
+                strict=True,
+            ):
+                column[b::n_batches] = values
+        return result.returns.reshape(len(roots), n_ep), result
+
+    def _map(self, cp, job_roots, job_eps, episodes, no_memory) -> list:
+        n_batches = plan_batches(len(job_roots), len(episodes.tasks), self.threads, self.min_roots)
+        [graph] = self.client.scatter([graph_arrays(cp)], broadcast=True, hash=False)
+        table = self._table(episodes)
+        futures = [
+            self.client.submit(
+                play_batch,
+                graph,
+                job_roots[b::n_batches],
+                job_eps[b::n_batches],
+                table,
+                no_memory,
+                pure=False,
+            )
+            for b in range(n_batches)
+        ]
+        try:
+            return self.client.gather(futures)
+        except Exception:
+            self._tables.clear()  # its copies may have died with the workers: send again
+            raise
+        finally:
+            for f in (*futures, graph):
+                f.release()
+
+    def _table(self, episodes: Episodes):
+        """The cluster's copy of an episode table, sent once per run and table."""
+        key = (episodes.tasks.tobytes(), episodes.seeds.tobytes())
+        if key not in self._tables:
+            if len(self._tables) >= TABLES_KEPT:
+                self._tables.pop(next(iter(self._tables))).release()
+            arrays = (episodes.tasks, episodes.starts, episodes.noise)
+            [self._tables[key]] = self.client.scatter([arrays], broadcast=True, hash=False)
+        return self._tables[key]
+
+    def check(self) -> None:
+        """Raises :class:`BackendLost` once the cluster was lost (at a generation boundary)."""
+        if self.lost is not None:
+            raise BackendLost(
+                f"lost the dask cluster at {self.address} ({self.lost}); the generation in "
+                "progress was finished on this machine and the run stopped there"
+            )
+
+    def close(self) -> None:
+        """Disconnects, and shuts down a local cluster started by this evaluator."""
+        for thing in (self.client, self.cluster):
+            if thing is not None:
+                try:
+                    thing.close()
+                except Exception as exc:  # noqa: BLE001 - closing a dead cluster
+                    print(f"closing the dask cluster: {exc}", file=sys.stderr)
+        self.cluster = None
+
+
+def _is_cluster_failure(exc: BaseException) -> bool:
+    """True for failures of the cluster itself (not of the evaluation code)."""
+    from concurrent.futures import CancelledError
+
+    from distributed import KilledWorker
+    from distributed.comm.core import CommClosedError
+
+    return isinstance(exc, OSError | TimeoutError | CancelledError | CommClosedError | KilledWorker)

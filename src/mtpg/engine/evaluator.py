@@ -1,0 +1,133 @@
+"""Where new roots are evaluated: this machine's threads or a Dask cluster.
+
+An :class:`Evaluator` plays every episode of a table with every given root of a compiled
+population and returns the outcomes in root-major order. Every backend returns the very
+same numbers: each job (root x episode) runs on its own with a fresh memory state, so
+neither the number of threads nor the number or placement of worker processes changes a
+bit of the result. Evaluation is pure (the same arguments always give the same result),
+which is what lets a cluster recompute a batch lost with a worker.
+
+Backends:
+
+* ``local`` (:class:`LocalEvaluator`, default): the engine's Numba threads.
+* ``dask`` (:class:`mtpg.engine.dask_backend.DaskEvaluator`): batches of roots on the
+  worker processes of a Dask cluster, either an existing one (``address``) or a local one
+  started for the run (``dask_workers``). Needs the optional ``dask`` extra.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from mtpg.config import ConfigError, RunConfig
+from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
+from mtpg.engine.compile import CompiledPopulation
+
+#: Names of the evaluation backends (``run.backend``).
+BACKENDS = ("local", "dask")
+
+
+class BackendLost(RuntimeError):
+    """The evaluation backend went away; the run stops at a generation boundary."""
+
+
+class Evaluator(Protocol):
+    """Plays episodes with roots of a compiled population."""
+
+    def evaluate(
+        self,
+        cp: CompiledPopulation,
+        root_ids: list[int],
+        episodes: Episodes,
+        no_memory: bool = False,
+    ) -> tuple[np.ndarray, BatchResult]:
+        """Plays every episode of ``episodes`` with every root.
+
+        Args:
+            cp: The compiled population.
+            root_ids: Model ids of the teams to evaluate.
+            episodes: The episode table.
+            no_memory: Zero each bank before every program execution (ablation).
+
+        Returns:
+            ``returns`` float64 ``[n_roots, n_episodes]`` and the flat per-job result
+            (root-major), exactly as :func:`mtpg.engine.batch.evaluate_roots`.
+        """
+        ...
+
+    def check(self) -> None:
+        """Raises :class:`BackendLost` when the backend was lost since the last call."""
+        ...
+
+    def close(self) -> None:
+        """Releases the backend's resources (idempotent)."""
+        ...
+
+
+class LocalEvaluator:
+    """Evaluates on this machine's Numba threads.
+
+    Args:
+        threads: Numba threads (1: the serial kernel, no thread pool).
+    """
+
+    def __init__(self, threads: int = 1) -> None:
+        if threads < 1:
+            raise ValueError(f"threads must be >= 1, got {threads}")
+        self.threads = threads
+
+    def evaluate(
+        self,
+        cp: CompiledPopulation,
+        root_ids: list[int],
+        episodes: Episodes,
+        no_memory: bool = False,
+    ) -> tuple[np.ndarray, BatchResult]:
+        """See :meth:`Evaluator.evaluate`."""
+        return evaluate_roots(cp, root_ids, episodes, self.threads, no_memory)
+
+    def check(self) -> None:
+        """A local backend is never lost."""
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+
+def make_evaluator(config: RunConfig) -> Evaluator:
+    """The evaluator a run configuration asks for.
+
+    Args:
+        config: The run configuration (``backend``, ``address``, ``dask_workers``,
+            ``workers``).
+
+    Returns:
+        A :class:`LocalEvaluator` or a connected
+        :class:`~mtpg.engine.dask_backend.DaskEvaluator`.
+
+    Raises:
+        ConfigError: The dask backend is requested but its packages are not installed.
+    """
+    if config.backend == "local":
+        return LocalEvaluator(config.workers)
+    if bool(config.address) == (config.dask_workers > 0):
+        raise ConfigError(
+            "run.backend 'dask' needs either run.address (a running cluster's scheduler, "
+            f"tcp://HOST:PORT) or run.dask_workers >= 1 (a local cluster), got address "
+            f"{config.address!r} and dask_workers {config.dask_workers}"
+        )
+    try:
+        import distributed  # noqa: F401
+    except ImportError as exc:
+        raise ConfigError(
+            "run.backend 'dask' needs the packages dask and distributed, which are not "
+            "installed; install them with: pip install 'mtpg[dask]'"
+        ) from exc
+    from mtpg.engine.dask_backend import DaskEvaluator
+
+    return DaskEvaluator(
+        address=config.address or None,
+        n_workers=config.dask_workers,
+        fallback_threads=config.workers,
+    )

@@ -46,7 +46,7 @@ def run(config, evaluator=None):
     while not trainer.done:
         row = trainer.run_generation()
         rows.append({k: v for k, v in row.items() if k not in TIMING_COLUMNS})
-        tests.append(trainer.test_champions())
+        tests.append(trainer.held_out_scores())
     return rows, tests, trainer.state.champions
 
 

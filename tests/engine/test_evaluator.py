@@ -19,13 +19,13 @@ def test_local_is_the_default_and_uses_the_workers_threads():
 
 
 def test_dask_backend_needs_an_address_or_workers_not_both():
-    with pytest.raises(ConfigError, match="run.address"):
+    with pytest.raises(ConfigError, match="address"):
         make_evaluator(config("backend=dask"))
-    with pytest.raises(ConfigError, match="run.address"):
+    with pytest.raises(ConfigError, match="address"):
         make_evaluator(config("backend=dask", "dask_workers=2", 'address="tcp://127.0.0.1:1"'))
-    with pytest.raises(ConfigError, match="run.backend"):
+    with pytest.raises(ConfigError, match="backend"):
         config("backend=ray")
-    with pytest.raises(ConfigError, match="run.dask_workers"):
+    with pytest.raises(ConfigError, match="dask_workers"):
         config("dask_workers=-1")
 
 

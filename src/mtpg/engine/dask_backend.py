@@ -137,7 +137,7 @@ class DaskEvaluator:
                 self.client = Client(address, timeout=timeout)
             except OSError as exc:
                 raise ConfigError(
-                    f"run.address: cannot reach the dask scheduler at {address}: {exc}"
+                    f"address: cannot reach the dask scheduler at {address}: {exc}"
                 ) from exc
         else:
             if n_workers < 1:
@@ -161,7 +161,7 @@ class DaskEvaluator:
         except ImportError as exc:
             self.close()
             raise ConfigError(
-                f"run.address: the workers of {self.address} cannot import mtpg ({exc}); "
+                f"address: the workers of {self.address} cannot import mtpg ({exc}); "
                 "install the same mtpg version on every worker"
             ) from exc
 

@@ -25,7 +25,7 @@ from mtpg.config import ConfigError, RunConfig
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
 
-#: Names of the evaluation backends (``run.backend``).
+#: Names of the evaluation backends (``backend``).
 BACKENDS = ("local", "dask")
 
 
@@ -113,15 +113,15 @@ def make_evaluator(config: RunConfig) -> Evaluator:
         return LocalEvaluator(config.workers)
     if bool(config.address) == (config.dask_workers > 0):
         raise ConfigError(
-            "run.backend 'dask' needs either run.address (a running cluster's scheduler, "
-            f"tcp://HOST:PORT) or run.dask_workers >= 1 (a local cluster), got address "
+            "backend 'dask' needs either address (a running cluster's scheduler, "
+            f"tcp://HOST:PORT) or dask_workers >= 1 (a local cluster), got address "
             f"{config.address!r} and dask_workers {config.dask_workers}"
         )
     try:
         import distributed  # noqa: F401
     except ImportError as exc:
         raise ConfigError(
-            "run.backend 'dask' needs the packages dask and distributed, which are not "
+            "backend 'dask' needs the packages dask and distributed, which are not "
             "installed; install them with: pip install 'mtpg[dask]'"
         ) from exc
     from mtpg.engine.dask_backend import DaskEvaluator

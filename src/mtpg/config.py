@@ -207,9 +207,7 @@ class RunConfig:
         _positive(self, "run", ("seed", "generations"), minimum=0)
         _positive(self, "run", ("workers", "checkpoint_interval"))
         _positive(self, "run", ("dask_workers",), minimum=0)
-        _check(
-            self.backend in ("local", "dask"), "backend", "must be local or dask", self.backend
-        )
+        _check(self.backend in ("local", "dask"), "backend", "must be local or dask", self.backend)
         # whether backend dask has an address or workers is checked when the run starts
         # (mtpg.engine.evaluator.make_evaluator): overrides arrive one field at a time
 

@@ -368,7 +368,7 @@ def run_hand(names: list[str]) -> list[dict[str, object]]:
         }
         print(f"{row['name']:32s} {verdict:9s} {row['seconds']:6.1f}s  {row['pytest']}", flush=True)
         rows.append(row)
-    (SCRATCH / "hand.json").write_text(json.dumps(rows, indent=2) + "\n")
+    work.with_suffix(".json").write_text(json.dumps(rows, indent=2) + "\n")
     return rows
 
 

@@ -246,15 +246,15 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "saturation-constant",
         "src/mtpg/model/instructions.py",
-        "BIG = 1e10",
-        "BIG = 1e9",
+        "\nBIG = 1e10\n",
+        "\nBIG = 1e9\n",
         _OPS,
     ),
     HandMutant(
         "pow-underflow-threshold",
         "src/mtpg/model/instructions.py",
-        "LOG_TINY = -700.0",
-        "LOG_TINY = -600.0",
+        "\nLOG_TINY = -700.0\n",
+        "\nLOG_TINY = -600.0\n",
         _OPS,
     ),
     HandMutant(

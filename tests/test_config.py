@@ -121,42 +121,60 @@ def test_ablations_each_change_one_setting() -> None:
     assert not build_config("paper").no_hierarchy
 
 
+ALL = "CartPole, Acrobot, CartCentering, Pendulum, MountainCar, MountainCarContinuous"
+
+
 @pytest.mark.parametrize(
-    ("override", "field"),
+    ("override", "message"),
     [
-        ("team.p_crossover=1.5", "team.p_crossover"),
-        ("team.p_crossover=-0.1", "team.p_crossover"),
-        ("program.p_swap=2", "program.p_swap"),
-        ("team.root_size=0", "team.root_size"),
-        ("team.n_elite=0", "team.n_elite"),
-        ("team.init_team_size=1", "team.init_team_size"),
-        ("team.min_elite_total=-1", "team.min_elite_total"),
-        ("team.max_team_size=0", "team.max_team_size"),
-        ("program.n_registers=0", "program.n_registers"),
-        ("program.n_memory=0", "program.n_memory"),
-        ("program.init_max_length=0", "program.init_max_length"),
-        ("program.max_length=5", "program.max_length"),
-        ("evaluation.train_episodes=0", "evaluation.train_episodes"),
-        ("evaluation.test_episodes=0", "evaluation.test_episodes"),
-        ("evaluation.test_interval=-1", "evaluation.test_interval"),
-        ("evaluation.tasks=[]", "evaluation.tasks"),
-        ('evaluation.tasks=["Pong"]', "evaluation.tasks"),
-        ('evaluation.tasks=["Pendulum", "Pendulum"]', "evaluation.tasks"),
-        ("seed=-1", "run.seed"),
-        ("generations=-1", "run.generations"),
-        ("workers=0", "run.workers"),
-        ("checkpoint_interval=0", "run.checkpoint_interval"),
-        ("team.root_size=1.5", "team.root_size"),
-        ("team.root_size=true", "team.root_size"),
-        ("evaluation.no_memory=1", "evaluation.no_memory"),
-        ("team.nope=1", "team.nope"),
-        ("team=3", "team"),
+        ("team.p_crossover=1.5", "team.p_crossover must be in [0, 1], got 1.5"),
+        ("team.p_crossover=-0.1", "team.p_crossover must be in [0, 1], got -0.1"),
+        ("program.p_swap=2", "program.p_swap must be in [0, 1], got 2.0"),
+        ("team.root_size=0", "team.root_size must be >= 1, got 0"),
+        ("team.n_elite=0", "team.n_elite must be >= 1, got 0"),
+        ("team.init_team_size=1", "team.init_team_size must be >= 2, got 1"),
+        ("team.min_elite_total=-1", "team.min_elite_total must be >= 0, got -1"),
+        ("team.max_team_size=0", "team.max_team_size must be >= 1, got 0"),
+        ("program.n_registers=0", "program.n_registers must be >= 1, got 0"),
+        ("program.n_memory=0", "program.n_memory must be >= 1, got 0"),
+        ("program.init_max_length=0", "program.init_max_length must be >= 1, got 0"),
+        (
+            "program.max_length=5",
+            "program.max_length must be >= program.init_max_length, got 5",
+        ),
+        ("evaluation.train_episodes=0", "evaluation.train_episodes must be >= 1, got 0"),
+        ("evaluation.test_episodes=0", "evaluation.test_episodes must be >= 1, got 0"),
+        ("evaluation.test_interval=-1", "evaluation.test_interval must be >= 0, got -1"),
+        ("evaluation.tasks=[]", "evaluation.tasks must name at least one task, got ()"),
+        ('evaluation.tasks=["Pong"]', f"evaluation.tasks must be among {ALL}, got 'Pong'"),
+        (
+            'evaluation.tasks=["Pendulum", "Pendulum"]',
+            "evaluation.tasks must not repeat a task, got ('Pendulum', 'Pendulum')",
+        ),
+        ("seed=-1", "run.seed must be >= 0, got -1"),
+        ("generations=-1", "run.generations must be >= 0, got -1"),
+        ("workers=0", "run.workers must be >= 1, got 0"),
+        ("checkpoint_interval=0", "run.checkpoint_interval must be >= 1, got 0"),
+        ("team.root_size=1.5", "team.root_size must be int, got float 1.5"),
+        ("team.root_size=true", "team.root_size must be int, got bool True"),
+        ("evaluation.no_memory=1", "evaluation.no_memory must be bool, got int 1"),
+        ('team.p_add="x"', "team.p_add must be float, got str 'x'"),
+        ("evaluation.tasks=3", "evaluation.tasks must be tuple[str, ...], got int 3"),
+        ("team.nope=1", "unknown field 'team.nope'"),
+        ("nope=1", "unknown field 'nope'"),
+        ("team=3", "team must be a table, got 3"),
     ],
 )
-def test_invalid_values_are_refused_naming_the_field(override: str, field: str) -> None:
+def test_invalid_values_are_refused_with_a_message_naming_the_field(
+    override: str, message: str
+) -> None:
     with pytest.raises(ConfigError) as err:
         build_config("paper", overrides=[override])
-    assert field in str(err.value)
+    assert str(err.value) == message
+
+
+def test_defaults_are_the_paper_preset() -> None:
+    assert build_config() == build_config("paper") == RunConfig()
 
 
 def test_boundary_values_are_accepted() -> None:

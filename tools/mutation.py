@@ -87,7 +87,7 @@ def _toml_list(items: list[str]) -> str:
     return "[" + ", ".join(json.dumps(i) for i in items) + "]"
 
 
-def run_mutmut(module: str) -> dict[str, int]:
+def run_mutmut(module: str) -> dict:
     """Runs mutmut on one module in its scratch copy and returns its counts."""
     mutate, tests = MODULES[module]
     work = SCRATCH / module
@@ -100,7 +100,7 @@ def run_mutmut(module: str) -> dict[str, int]:
             f"only_mutate = {_toml_list(mutate)}\n"
             f"pytest_add_cli_args_test_selection = {_toml_list(tests)}\n"
             'pytest_add_cli_args = ["-p", "no:cacheprovider", "-q", "-x"]\n'
-            # the machine is shared: generous timeouts, so slowness is not read as a kill
+            # the machine may be shared: generous timeouts, so a slow run is not a timeout
             "timeout_multiplier = 50.0\n"
             "timeout_constant = 30.0\n"
         )
@@ -110,6 +110,15 @@ def run_mutmut(module: str) -> dict[str, int]:
         subprocess.run(
             [MUTMUT, "run", "--max-children", "1"], cwd=work, stdout=out, stderr=out, check=False
         )
+    stats = summarize(module)
+    stats["seconds"] = round(time.perf_counter() - start)
+    (SCRATCH / f"{module}.json").write_text(json.dumps(stats, indent=2) + "\n")
+    return stats
+
+
+def summarize(module: str) -> dict:
+    """Counts of a finished (or interrupted) mutmut run of ``module`` and its non-killed."""
+    work = SCRATCH / module
     subprocess.run([MUTMUT, "export-cicd-stats"], cwd=work, capture_output=True, check=True)
     stats = json.loads((work / "mutants" / "mutmut-cicd-stats.json").read_text())
     results = subprocess.run(
@@ -117,9 +126,7 @@ def run_mutmut(module: str) -> dict[str, int]:
     ).stdout
     rows = [line.rsplit(":", 1) for line in results.splitlines() if ":" in line]
     stats["not_killed"] = {name.strip(): status.strip() for name, status in rows}
-    stats["seconds"] = round(time.perf_counter() - start)
-    stats["tests"] = tests
-    (SCRATCH / f"{module}.json").write_text(json.dumps(stats, indent=2) + "\n")
+    stats["tests"] = MODULES[module][1]
     return stats
 
 
@@ -398,6 +405,8 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     mm = sub.add_parser("mutmut", help="run mutmut on pure-Python modules")
     mm.add_argument("modules", nargs="+", choices=sorted(MODULES))
+    summary = sub.add_parser("summary", help="summarise finished mutmut runs")
+    summary.add_argument("modules", nargs="+", choices=sorted(MODULES))
     hand = sub.add_parser("hand", help="run the hand-written kernel and task mutants")
     hand.add_argument("names", nargs="*", help="mutant names (default: all)")
     args = parser.parse_args(argv)
@@ -407,11 +416,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{len(rows) - len(survived)}/{len(rows)} hand mutants killed")
         return 1 if survived else 0
     for module in args.modules:
-        stats = run_mutmut(module)
+        stats = run_mutmut(module) if args.command == "mutmut" else summarize(module)
         killed, survived = stats["killed"], stats["survived"]
         print(
             f"{module}: {killed} killed, {survived} survived, {stats['no_tests']} without tests, "
-            f"{stats['timeout']} timeouts, of {stats['total']} ({stats['seconds']} s)",
+            f"{stats['timeout']} timeouts, {stats['suspicious']} suspicious, of {stats['total']}",
             flush=True,
         )
     return 0

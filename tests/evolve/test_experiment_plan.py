@@ -57,7 +57,7 @@ def test_state_and_command_of_new_partial_and_done_runs(tmp_path) -> None:
         str(run.path),
     ]
     plain = PlannedRun(tmp_path / "TPG-seed0", 0, None).command([], 7, 1)
-    assert "--no-memory" not in plain and plain[-6:-4] == ["--generations", "7"]
+    assert plain[7:] == ["--generations", "7", "--seed", "0", "--out", str(tmp_path / "TPG-seed0")]
     make_run_dir(run.path, [2, 4])
     assert run.state(5) == "partial"
     assert run.state(4) == "done" and run.state(3) == "done"
@@ -72,21 +72,58 @@ def test_state_and_command_of_new_partial_and_done_runs(tmp_path) -> None:
     assert empty.state(1) == "partial"
 
 
-def test_execute_skips_done_runs_runs_the_rest_and_reports_failures(tmp_path, monkeypatch):
-    runs = plan(tmp_path / "exp", seeds=3, ablation_seeds=0)
-    make_run_dir(runs[0].path, [4])  # already done
-    exit_codes = {runs[1].path.name: 0, runs[2].path.name: 3}
+def stand_in(monkeypatch, exit_codes, seen):
+    """Replaces each run's training command by a short process with a chosen exit code."""
 
     def command(self, train_args, generations, workers):
+        seen.append((self.path.name, list(train_args), generations, workers))
         code = exit_codes[self.path.name]
-        return [sys.executable, "-c", f"print('{self.path.name}'); raise SystemExit({code})"]
+        script = (
+            "import sys, time; time.sleep(0.3); print('out'); print('err', file=sys.stderr); "
+            f"raise SystemExit({code})"
+        )
+        return [sys.executable, "-c", script]
 
     monkeypatch.setattr(experiment.PlannedRun, "command", command)
+
+
+def test_execute_skips_done_runs_runs_the_rest_and_reports_failures(tmp_path, monkeypatch):
+    folder = tmp_path / "deep" / "exp"  # created with its parents
+    runs = plan(folder, seeds=3, ablation_seeds=0)
+    make_run_dir(runs[0].path, [4])  # already done
+    make_run_dir(runs[2].path, [2])  # partial: resumed
+    seen: list = []
+    stand_in(monkeypatch, {runs[1].path.name: 0, runs[2].path.name: 3}, seen)
     lines: list[str] = []
-    failed = execute(runs, [], generations=4, parallel=2, log=lines.append)
+    failed = execute(runs, ["--tasks", "CartPole"], generations=4, log=lines.append)
     assert failed == [runs[2]]
-    assert "TPG-seed0: done" in lines
-    assert "TPG-seed1: new -> starting" in lines and "TPG-seed1: finished" in lines
-    assert "TPG-seed2: failed (3)" in lines
-    assert (tmp_path / "exp" / "TPG-seed1.log").read_text() == "TPG-seed1\n"
-    assert not (tmp_path / "exp" / "TPG-seed0.log").exists()
+    # defaults: one process at a time, one worker each
+    assert lines == [
+        "TPG-seed0: done",
+        "TPG-seed1: new -> starting",
+        "TPG-seed1: finished",
+        "TPG-seed2: partial -> starting",
+        "TPG-seed2: failed (3)",
+    ]
+    assert seen == [
+        ("TPG-seed1", ["--tasks", "CartPole"], 4, 1),
+        ("TPG-seed2", ["--tasks", "CartPole"], 4, 1),
+    ]
+    # stdout and stderr of each run go to its log file
+    assert (folder / "TPG-seed1.log").read_text() == "out\nerr\n"
+    assert not (folder / "TPG-seed0.log").exists()
+
+
+def test_execute_runs_at_most_parallel_processes(tmp_path, monkeypatch):
+    runs = plan(tmp_path / "exp", seeds=3, ablation_seeds=0)
+    seen: list = []
+    stand_in(monkeypatch, dict.fromkeys((r.path.name for r in runs), 0), seen)
+    lines: list[str] = []
+    assert execute(runs, [], generations=2, parallel=2, workers=3, log=lines.append) == []
+    assert lines[:2] == ["TPG-seed0: new -> starting", "TPG-seed1: new -> starting"]
+    assert lines.index("TPG-seed2: new -> starting") > 2  # waits for a free slot
+    assert {w for *_, w in seen} == {3}
+    # more slots than runs
+    runs = plan(tmp_path / "exp2", seeds=2, ablation_seeds=0)
+    stand_in(monkeypatch, dict.fromkeys((r.path.name for r in runs), 0), seen)
+    assert execute(runs, [], generations=2, parallel=3, log=lambda _: None) == []

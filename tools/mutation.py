@@ -130,6 +130,41 @@ def summarize(module: str) -> dict:
     return stats
 
 
+def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
+    """Re-tests the non-killed mutants of a mutmut run against the current tests.
+
+    Each mutant is applied with ``mutmut apply`` to a fresh copy of ``src/`` in the
+    module's scratch directory, and the current ``tests/`` run against it (``tests``, or
+    the module's test files). Used after adding tests, without redoing the whole run.
+    """
+    work = SCRATCH / module
+    stats = summarize(module)
+    todo = names or [n for n, status in stats["not_killed"].items() if status != "killed"]
+    ignore = shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc", ".hypothesis")
+    shutil.rmtree(work / "tests")
+    shutil.copytree(ROOT / "tests", work / "tests", ignore=ignore)
+    verdicts = {}
+    for name in todo:
+        shutil.copytree(ROOT / "src", work / "src", ignore=ignore, dirs_exist_ok=True)
+        subprocess.run([MUTMUT, "apply", name], cwd=work, check=True, capture_output=True)
+        proc = subprocess.run(
+            [PYTHON, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider"]
+            + (tests or MODULES[module][1]),
+            cwd=work,
+            capture_output=True,
+            text=True,
+            env=_env(work, "recheck"),
+            check=False,
+        )
+        verdicts[name] = {0: "survived", 1: "killed"}.get(
+            proc.returncode, f"error {proc.returncode}"
+        )
+        print(f"{name}: {verdicts[name]}", flush=True)
+    shutil.copytree(ROOT / "src", work / "src", ignore=ignore, dirs_exist_ok=True)
+    (SCRATCH / f"{module}-recheck.json").write_text(json.dumps(verdicts, indent=2) + "\n")
+    return verdicts
+
+
 @dataclass(frozen=True)
 class HandMutant:
     """One hand-written mutant: replace ``old`` (which must occur once) by ``new``."""
@@ -407,9 +442,18 @@ def main(argv: list[str] | None = None) -> int:
     mm.add_argument("modules", nargs="+", choices=sorted(MODULES))
     summary = sub.add_parser("summary", help="summarise finished mutmut runs")
     summary.add_argument("modules", nargs="+", choices=sorted(MODULES))
+    again = sub.add_parser("recheck", help="re-test non-killed mutants with the current tests")
+    again.add_argument("module", choices=sorted(MODULES))
+    again.add_argument("names", nargs="*", help="mutant names (default: every non-killed)")
+    again.add_argument("--tests", nargs="+", default=[], help="test files (default: module's)")
     hand = sub.add_parser("hand", help="run the hand-written kernel and task mutants")
     hand.add_argument("names", nargs="*", help="mutant names (default: all)")
     args = parser.parse_args(argv)
+    if args.command == "recheck":
+        verdicts = recheck(args.module, args.tests, args.names)
+        alive = [n for n, v in verdicts.items() if v != "killed"]
+        print(f"{len(verdicts) - len(alive)}/{len(verdicts)} killed by the current tests")
+        return 1 if alive else 0
     if args.command == "hand":
         rows = run_hand(args.names)
         survived = [r["name"] for r in rows if r["verdict"] != "killed"]

@@ -182,6 +182,7 @@ def test_prune_deletes_only_programs_no_team_holds() -> None:
         (lambda pop: setattr(pop.programs[4], "action", 9), "program 4 points to missing team"),
         (lambda pop: setattr(pop.programs[0], "action", atomic(3)), "program 0 action -4"),
         (lambda pop: setattr(pop.programs[0], "bank", 5), "program 0 bank 5"),
+        (lambda pop: setattr(pop.programs[0], "bank", 1), "program 0 bank 1"),  # next id
         (lambda pop: setattr(pop.programs[0], "bank", -1), "program 0 bank -1"),
         (
             lambda pop: setattr(pop.programs[1], "instructions", np.array([[0, 40, 0, 0]])),

@@ -101,8 +101,8 @@ def run_mutmut(module: str) -> dict:
             f"pytest_add_cli_args_test_selection = {_toml_list(tests)}\n"
             'pytest_add_cli_args = ["-p", "no:cacheprovider", "-q", "-x"]\n'
             # the machine may be shared: generous timeouts, so a slow run is not a timeout
-            "timeout_multiplier = 50.0\n"
-            "timeout_constant = 30.0\n"
+            "timeout_multiplier = 10.0\n"
+            "timeout_constant = 20.0\n"
         )
     start = time.perf_counter()
     log = work / "mutmut.log"

@@ -115,11 +115,12 @@ def test_execute_skips_done_runs_runs_the_rest_and_reports_failures(tmp_path, mo
 
 
 def test_execute_runs_at_most_parallel_processes(tmp_path, monkeypatch):
-    runs = plan(tmp_path / "exp", seeds=3, ablation_seeds=0)
+    runs = plan(tmp_path / "new" / "exp", seeds=3, ablation_seeds=0)  # folders made as needed
     seen: list = []
     stand_in(monkeypatch, dict.fromkeys((r.path.name for r in runs), 0), seen)
     lines: list[str] = []
     assert execute(runs, [], generations=2, parallel=2, workers=3, log=lines.append) == []
+    assert (tmp_path / "new" / "exp" / "TPG-seed2.log").is_file()
     assert lines[:2] == ["TPG-seed0: new -> starting", "TPG-seed1: new -> starting"]
     assert lines.index("TPG-seed2: new -> starting") > 2  # waits for a free slot
     assert {w for *_, w in seen} == {3}

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from mtpg.config import ConfigError, build_config
+from mtpg.evolve import trainer as trainer_module
 from mtpg.evolve.persist import state_from_payload, state_to_payload
 from mtpg.evolve.session import Session, read_run_config
 from mtpg.evolve.trainer import Trainer
@@ -76,6 +77,8 @@ def test_run_all_checkpoints_tests_and_calls_back(tmp_path) -> None:
         assert float(row["t_total"]) == pytest.approx(parts + float(row["t_test"]), abs=1e-3)
     tests = read_rows(run / "tests.csv")
     assert [r["generation"] for r in tests] == ["2"] * 3 + ["4"] * 3
+    for r in tests:
+        assert 1.0 <= float(r["teams_per_decision"]) <= int(r["graph_teams"])
     assert [r["subset"] for r in tests[:3]] == ["CartPole", "MountainCar", "CartPole+MountainCar"]
     # graphs of the single-task and full-set champions at every test point
     for gen, rows_at in (("000002", tests[:3]), ("000004", tests[3:])):
@@ -161,3 +164,27 @@ def test_payload_round_trip_and_errors() -> None:
         FormatError, match=r"^run state: scored roots \[999, 998, 997\] are not in the population$"
     ):
         state_from_payload(bad)
+
+
+def test_test_seeds_are_held_out() -> None:
+    seeds = trainer_module.test_seeds(3)
+    assert seeds.tolist() == [1_000_000, 1_000_001, 1_000_002] and seeds.dtype == np.int64
+    assert trainer_module.test_seeds(2, offset=5).tolist() == [1_000_005, 1_000_006]
+    with pytest.raises(ValueError, match="^test seed offset must be >= 0, got -1$"):
+        trainer_module.test_seeds(2, offset=-1)
+
+
+@pytest.mark.parametrize("no_memory", [False, True])
+def test_champion_tests_honour_the_memory_ablation(monkeypatch, no_memory: bool) -> None:
+    trainer = Trainer(tiny(1, f"evaluation.no_memory={str(no_memory).lower()}"))
+    trainer.run_generation()
+    seen = []
+    real = trainer_module.evaluate_roots
+
+    def spy(*args, **kwargs):
+        seen.append(args[4] if len(args) > 4 else kwargs["no_memory"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(trainer_module, "evaluate_roots", spy)
+    trainer.test_champions()
+    assert seen == [no_memory]

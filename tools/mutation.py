@@ -131,37 +131,53 @@ def summarize(module: str) -> dict:
 
 
 def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
-    """Re-tests the non-killed mutants of a mutmut run against the current tests.
+    """Re-tests the non-killed mutants of a finished mutmut run against the current tests.
 
-    Each mutant is applied with ``mutmut apply`` to a fresh copy of ``src/`` in the
-    module's scratch directory, and the current ``tests/`` run against it (``tests``, or
-    the module's test files). Used after adding tests, without redoing the whole run.
+    The current ``tests/`` replace the copy inside the run's ``mutants/`` directory; then
+    one process imports the mutated package once and, per mutant, forks a child that
+    activates the mutant (mutmut's own switch) and runs ``tests`` (default: the module's
+    test files) with ``-x``. Used after adding tests, without redoing the whole run.
     """
     work = SCRATCH / module
     stats = summarize(module)
-    alive = ("survived", "suspicious", "timeout", "no tests")
+    alive = ("survived", "suspicious", "timeout", "no tests", "segfault")
     todo = names or [n for n, status in stats["not_killed"].items() if status in alive]
     ignore = shutil.ignore_patterns("__pycache__", "*.nbi", "*.nbc", ".hypothesis")
-    shutil.rmtree(work / "tests")
-    shutil.copytree(ROOT / "tests", work / "tests", ignore=ignore)
+    shutil.rmtree(work / "mutants" / "tests")
+    shutil.copytree(ROOT / "tests", work / "mutants" / "tests", ignore=ignore)
+    args = ["-q", "-x", "-p", "no:cacheprovider", *(tests or MODULES[module][1])]
+    script = (
+        "import json, os, sys\n"
+        "sys.path.insert(0, 'src')\n"
+        "import pytest, mtpg.evolve.trainer, mtpg.engine.batch\n"
+        "from mutmut.mutation.trampoline import set_mutant_under_test\n"
+        "names, args = json.loads(sys.argv[1]), json.loads(sys.argv[2])\n"
+        "for name in names:\n"
+        "    pid = os.fork()\n"
+        "    if pid == 0:\n"
+        "        set_mutant_under_test(name)\n"
+        "        sys.stdout = sys.stderr = open(os.devnull, 'w')\n"
+        "        os._exit(int(pytest.main(args)))\n"
+        "    _, status = os.waitpid(pid, 0)\n"
+        "    code = os.waitstatus_to_exitcode(status)\n"
+        "    print(json.dumps([name, code]), flush=True)\n"
+    )
     verdicts = {}
-    for name in todo:
-        shutil.copytree(ROOT / "src", work / "src", ignore=ignore, dirs_exist_ok=True)
-        subprocess.run([MUTMUT, "apply", name], cwd=work, check=True, capture_output=True)
-        proc = subprocess.run(
-            [PYTHON, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider"]
-            + (tests or MODULES[module][1]),
-            cwd=work,
-            capture_output=True,
-            text=True,
-            env=_env(work, "recheck"),
-            check=False,
-        )
-        verdicts[name] = {0: "survived", 1: "killed"}.get(
-            proc.returncode, f"error {proc.returncode}"
-        )
+    env = dict(os.environ)
+    env.pop("PYTHONPATH", None)
+    proc = subprocess.Popen(
+        [PYTHON, "-c", script, json.dumps(todo), json.dumps(args)],
+        cwd=work / "mutants",
+        stdout=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        name, code = json.loads(line)
+        verdicts[name] = {0: "survived", 1: "killed"}.get(code, f"error {code}")
         print(f"{name}: {verdicts[name]}", flush=True)
-    shutil.copytree(ROOT / "src", work / "src", ignore=ignore, dirs_exist_ok=True)
+    proc.wait()
     (SCRATCH / f"{module}-recheck.json").write_text(json.dumps(verdicts, indent=2) + "\n")
     return verdicts
 

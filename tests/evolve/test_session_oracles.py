@@ -72,6 +72,7 @@ def test_run_all_checkpoints_tests_and_calls_back(tmp_path) -> None:
     for row in rows:
         tested = int(row["generation"]) in (2, 4)
         assert (float(row["t_test"]) > 0) == tested
+        assert float(row["t_test"]) < 300  # a duration, not a clock reading
         assert float(row["t_total"]) >= float(row["t_test"])
         parts = sum(float(row[k]) for k in ("t_variation", "t_evaluation", "t_selection"))
         assert float(row["t_total"]) == pytest.approx(parts + float(row["t_test"]), abs=1e-3)
@@ -188,3 +189,17 @@ def test_champion_tests_honour_the_memory_ablation(monkeypatch, no_memory: bool)
     monkeypatch.setattr(trainer_module, "evaluate_roots", spy)
     trainer.test_champions()
     assert seen == [no_memory]
+
+
+def test_resume_drops_test_rows_after_the_checkpoint(tmp_path) -> None:
+    run = tmp_path / "run"
+    Session(run, tiny(3, "evaluation.test_interval=1", "checkpoint_interval=2")).run_all()
+    assert [g for g, _ in list_checkpoints(run)] == [2, 3]
+    list_checkpoints(run)[-1][1].unlink()  # as if killed after generation 3's rows
+    assert {r["generation"] for r in read_rows(run / "tests.csv")} == {"1", "2", "3"}
+    session = Session(run, resume=True)
+    assert session.trainer.state.generation == 2
+    session.tests.close()
+    session.metrics.close()
+    assert {r["generation"] for r in read_rows(run / "tests.csv")} == {"1", "2"}
+    assert [r["generation"] for r in read_rows(run / "metrics.csv")] == ["1", "2"]

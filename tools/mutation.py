@@ -147,7 +147,7 @@ def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
     shutil.copytree(ROOT / "tests", work / "mutants" / "tests", ignore=ignore)
     args = ["-q", "-x", "-p", "no:cacheprovider", *(tests or MODULES[module][1])]
     script = (
-        "import json, os, sys\n"
+        "import json, os, signal, sys\n"
         "sys.path.insert(0, 'src')\n"
         "import pytest, mtpg.evolve.trainer, mtpg.engine.batch\n"
         "from mutmut.mutation.trampoline import set_mutant_under_test\n"
@@ -156,6 +156,7 @@ def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
         "    pid = os.fork()\n"
         "    if pid == 0:\n"
         "        set_mutant_under_test(name)\n"
+        "        signal.alarm(120)  # a mutant that loops is a timeout\n"
         "        sys.stdout = sys.stderr = open(os.devnull, 'w')\n"
         "        os._exit(int(pytest.main(args)))\n"
         "    _, status = os.waitpid(pid, 0)\n"
@@ -175,7 +176,7 @@ def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
     assert proc.stdout is not None
     for line in proc.stdout:
         name, code = json.loads(line)
-        verdicts[name] = {0: "survived", 1: "killed"}.get(code, f"error {code}")
+        verdicts[name] = {0: "survived", 1: "killed", -14: "timeout"}.get(code, f"error {code}")
         print(f"{name}: {verdicts[name]}", flush=True)
     proc.wait()
     (SCRATCH / f"{module}-recheck.json").write_text(json.dumps(verdicts, indent=2) + "\n")

@@ -96,6 +96,7 @@ def test_run_all_checkpoints_tests_and_calls_back(tmp_path) -> None:
         }
     _, _, meta = load_graph(run / "champions" / "CartPole.json")
     assert meta["generation"] == 5 and set(meta["train_scores"]) == {"CartPole"}
+    assert meta["seed"] == 0
 
 
 def test_three_tasks_keep_single_and_full_set_graphs_only(tmp_path) -> None:
@@ -132,6 +133,8 @@ def test_session_errors_name_the_problem(tmp_path) -> None:
     Session(run, tiny(1)).run_all()
     with pytest.raises(ConfigError, match=r"differs in seed\); only generations, workers"):
         Session(run, tiny(2, "seed=1"), resume=True)
+    with pytest.raises(ConfigError, match=r"\(differs in seed, team\); only generations"):
+        Session(run, tiny(2, "seed=1", "team.p_add=0.5"), resume=True)
     ckpt = list_checkpoints(run)[-1][1]
     payload = load_checkpoint(ckpt)
     del payload["population"]

@@ -116,3 +116,26 @@ def test_crossover_keeps_an_atomic_program_and_at_least_two() -> None:
         kid = pop.teams[varier.child(a, b)].programs
         assert len(kid) >= 2
         assert any(pop.programs[p].is_atomic for p in kid)
+
+
+def test_initial_population_follows_the_configured_sizes() -> None:
+    from mtpg.evolve.variation import init_population
+    from mtpg.model.instructions import RegisterLayout
+
+    config = build_config(
+        "paper",
+        overrides=[
+            "team.root_size=30",
+            "team.init_team_size=4",
+            "program.n_registers=4",
+            "program.n_memory=6",
+            "program.init_max_length=3",
+        ],
+    )
+    pop = init_population(config, np.random.default_rng(0))
+    assert pop.layout == RegisterLayout(4, 6)
+    assert len(pop.roots()) == 30 and all(len(t.programs) == 4 for t in pop.teams.values())
+    assert {len(p.instructions) for p in pop.programs.values()} == {1, 2, 3}
+    assert {p.atomic_action for p in pop.programs.values()} == {0, 1, 2}
+    assert len({p.bank for p in pop.programs.values()}) == len(pop.programs) == 120
+    check_invariants(pop)

@@ -139,3 +139,57 @@ def test_initial_population_follows_the_configured_sizes() -> None:
     assert {p.atomic_action for p in pop.programs.values()} == {0, 1, 2}
     assert len({p.bank for p in pop.programs.values()}) == len(pop.programs) == 120
     check_invariants(pop)
+
+
+def program_config(**probs):
+    settings = {"p_delete": 0.0, "p_add": 0.0, "p_mutate": 0.0, "p_swap": 0.0, **probs}
+    overrides = [f"program.{k}={v}" for k, v in settings.items()]
+    return build_config("paper", overrides=overrides).program
+
+
+def test_mutate_code_deletes_inserts_changes_and_swaps_as_configured() -> None:
+    from mtpg.evolve.variation import mutate_code
+    from mtpg.model.instructions import RegisterLayout, random_instructions
+
+    layout = RegisterLayout()
+    rng = np.random.default_rng(0)
+    code = random_instructions(rng, layout, 5)
+    deleted = set()
+    for _ in range(200):  # delete only: one instruction, any position
+        out = mutate_code(code, program_config(p_delete=1.0), layout, rng)
+        assert len(out) == 4
+        gone = [k for k in range(5) if not any((out == code[k]).all(axis=1))]
+        deleted.update(gone)
+    assert deleted == set(range(5))
+    two = code[:2]
+    assert len(mutate_code(two, program_config(p_delete=1.0), layout, rng)) == 1
+    one = code[:1]
+    assert np.array_equal(mutate_code(one, program_config(p_delete=1.0), layout, rng), one)
+    # nothing switched on: an identical copy
+    same = mutate_code(code, program_config(), layout, rng)
+    assert np.array_equal(same, code) and same is not code
+    # insert only: one longer, but never beyond max_length
+    assert len(mutate_code(code, program_config(p_add=1.0), layout, rng)) == 6
+    limits = ["program.max_length=10", "program.p_add=1.0", "program.p_delete=0.0"]
+    limits += ["program.p_mutate=0.0", "program.p_swap=0.0"]
+    capped = build_config("paper", overrides=limits).program
+    full = random_instructions(rng, layout, 10)
+    assert len(mutate_code(full, capped, layout, rng)) == 10
+    # change one field only: exactly one entry differs
+    for _ in range(50):
+        out = mutate_code(code, program_config(p_mutate=1.0), layout, rng)
+        assert out.shape == code.shape and (out != code).sum() == 1
+    # swap only: the same rows, two of them exchanged
+    for _ in range(50):
+        out = mutate_code(code, program_config(p_swap=1.0), layout, rng)
+        moved = [k for k in range(5) if not (out[k] == code[k]).all()]
+        assert len(moved) in (0, 2)  # 0 only if the two rows were equal
+        assert sorted(map(tuple, out)) == sorted(map(tuple, code))
+
+
+def test_initial_roots_are_born_in_generation_zero() -> None:
+    from mtpg.evolve.variation import init_population
+
+    config = build_config("paper", overrides=["team.root_size=5", "team.init_team_size=2"])
+    pop = init_population(config, np.random.default_rng(1))
+    assert [t.birth for t in pop.teams.values()] == [0] * 5

@@ -134,3 +134,10 @@ def test_min_elite_total_in_a_run_keeps_the_rounded_up_count() -> None:
     assert [len(e) for e in trainer.state.elites] == [4, 4, 4]
     assert rows[0]["new_roots"] == 30 and rows[1]["new_roots"] == rows[2]["new_roots"] == 12
     assert rows[-1]["roots"] == 12
+
+
+def test_normalise_shifts_by_the_minimum() -> None:
+    from mtpg.evolve.selection import normalise
+
+    out = normalise(np.array([[2.0, -3.0], [4.0, -1.0], [3.0, -2.0]]))
+    assert out.tolist() == [[0.0, 0.0], [1.0, 1.0], [0.5, 0.5]]

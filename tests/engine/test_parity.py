@@ -138,3 +138,10 @@ def test_no_memory_mode_differs_only_by_memory():
     with_mem, _ = evaluate_roots(cp, roots, episodes)
     without, _ = evaluate_roots(cp, roots, episodes, no_memory=True)
     assert not np.array_equal(with_mem, without)
+    # in both modes the production kernel equals the reference interpreter, which differs
+    # between the modes only in zeroing the banks before every program execution
+    for i, root in enumerate(roots[:8]):
+        for returns, no_memory in ((with_mem, False), (without, True)):
+            agent = ReferenceAgent(pop, root, no_memory=no_memory)
+            total, _ = reference_episode(agent, 3, episodes.starts[0], episodes.noise[0])
+            assert returns[i, 0] == total, (root, no_memory)

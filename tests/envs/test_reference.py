@@ -48,7 +48,8 @@ def test_normalise() -> None:
     assert math.isnan(REFERENCE[CARTCENTERING].solved)
 
 
-@pytest.mark.slow
+# Guards the stored random-agent figures that every normalised score depends on. It takes
+# a few seconds on an idle machine, so it runs in the default suite.
 @pytest.mark.parametrize("task", range(len(TASK_NAMES)))
 def test_random_figures_match_remeasurement(task: int) -> None:
     mean, std = measure_random(task)

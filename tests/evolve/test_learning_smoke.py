@@ -35,10 +35,10 @@ def test_short_cartpole_run_beats_random_play_on_held_out_episodes() -> None:
     )
     trainer = Trainer(config)
     trainer.run_generation()
-    first = trainer.test_champions()[0]["test_CartPole"]
+    first = trainer.held_out_scores()[0]["test_CartPole"]
     while not trainer.done:
         trainer.run_generation()
-    last = trainer.test_champions()[0]["test_CartPole"]
+    last = trainer.held_out_scores()[0]["test_CartPole"]
     random = REFERENCE[CARTPOLE].random
     assert last >= random + MARGIN, (first, last, random)
     assert last >= first + MARGIN, (first, last)

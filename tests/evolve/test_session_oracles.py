@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from mtpg.config import ConfigError, build_config
-from mtpg.evolve import trainer as trainer_module
+from mtpg.engine import evaluator as evaluator_module
+from mtpg.envs.protocol import held_out_seeds
 from mtpg.evolve.persist import state_from_payload, state_to_payload
 from mtpg.evolve.session import Session, read_run_config
 from mtpg.evolve.trainer import Trainer
@@ -40,14 +41,14 @@ def tiny(generations: int = 3, *extra: str):
 
 @pytest.mark.parametrize(
     ("interval", "due"),
-    [(0, []), (1, [1, 2, 3, 4, 5, 6]), (2, [2, 4, 6]), (5, [5])],
+    [(0, []), (1, [1, 2, 3, 4, 5, 6]), (2, [2, 4, 6]), (5, [5, 6]), (4, [4, 6])],
 )
 def test_test_points(interval: int, due: list[int]) -> None:
     trainer = Trainer(tiny(6, f"evaluation.test_interval={interval}"))
     got = []
     for gen in range(1, 7):
         trainer.state.generation = gen
-        if trainer.test_due():
+        if trainer.held_out_due():
             got.append(gen)
     assert got == due
 
@@ -70,14 +71,14 @@ def test_run_all_checkpoints_tests_and_calls_back(tmp_path) -> None:
     assert session.saved_generation == 5
     rows = read_rows(run / "metrics.csv")
     for row in rows:
-        tested = int(row["generation"]) in (2, 4)
+        tested = int(row["generation"]) in (2, 4, 5)  # and the last generation
         assert (float(row["t_test"]) > 0) == tested
         assert float(row["t_test"]) < 300  # a duration, not a clock reading
         assert float(row["t_total"]) >= float(row["t_test"])
         parts = sum(float(row[k]) for k in ("t_variation", "t_evaluation", "t_selection"))
         assert float(row["t_total"]) == pytest.approx(parts + float(row["t_test"]), abs=1e-3)
     tests = read_rows(run / "tests.csv")
-    assert [r["generation"] for r in tests] == ["2"] * 3 + ["4"] * 3
+    assert [r["generation"] for r in tests] == ["2"] * 3 + ["4"] * 3 + ["5"] * 3
     for r in tests:
         assert 1.0 <= float(r["teams_per_decision"]) <= int(r["graph_teams"])
     assert [r["subset"] for r in tests[:3]] == ["CartPole", "MountainCar", "CartPole+MountainCar"]
@@ -133,7 +134,7 @@ def test_session_errors_name_the_problem(tmp_path) -> None:
     Session(run, tiny(1)).run_all()
     with pytest.raises(ConfigError, match=r"differs in seed\); only generations, workers"):
         Session(run, tiny(2, "seed=1"), resume=True)
-    with pytest.raises(ConfigError, match=r"\(differs in seed, team\); only generations"):
+    with pytest.raises(ConfigError, match=r"\(differs in seed, team.p_add\); only generations"):
         Session(run, tiny(2, "seed=1", "team.p_add=0.5"), resume=True)
     ckpt = list_checkpoints(run)[-1][1]
     payload = load_checkpoint(ckpt)
@@ -142,7 +143,7 @@ def test_session_errors_name_the_problem(tmp_path) -> None:
     with pytest.raises(CheckpointError, match=rf"^{ckpt}: not a valid run state: run state: "):
         Session(run, resume=True)
     (run / "config.toml").write_text("seed = -1\n")
-    with pytest.raises(ConfigError, match=rf"^{run / 'config.toml'}: run.seed must be >= 0"):
+    with pytest.raises(ConfigError, match=rf"^{run / 'config.toml'}: seed must be >= 0"):
         read_run_config(run)
 
 
@@ -171,11 +172,11 @@ def test_payload_round_trip_and_errors() -> None:
 
 
 def test_test_seeds_are_held_out() -> None:
-    seeds = trainer_module.test_seeds(3)
+    seeds = held_out_seeds(3)
     assert seeds.tolist() == [1_000_000, 1_000_001, 1_000_002] and seeds.dtype == np.int64
-    assert trainer_module.test_seeds(2, offset=5).tolist() == [1_000_005, 1_000_006]
+    assert held_out_seeds(2, offset=5).tolist() == [1_000_005, 1_000_006]
     with pytest.raises(ValueError, match="^test seed offset must be >= 0, got -1$"):
-        trainer_module.test_seeds(2, offset=-1)
+        held_out_seeds(2, offset=-1)
 
 
 @pytest.mark.parametrize("no_memory", [False, True])
@@ -183,14 +184,14 @@ def test_champion_tests_honour_the_memory_ablation(monkeypatch, no_memory: bool)
     trainer = Trainer(tiny(1, f"evaluation.no_memory={str(no_memory).lower()}"))
     trainer.run_generation()
     seen = []
-    real = trainer_module.evaluate_roots
+    real = evaluator_module.evaluate_roots
 
     def spy(*args, **kwargs):
         seen.append(args[4] if len(args) > 4 else kwargs["no_memory"])
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(trainer_module, "evaluate_roots", spy)
-    trainer.test_champions()
+    monkeypatch.setattr(evaluator_module, "evaluate_roots", spy)
+    trainer.held_out_scores()
     assert seen == [no_memory]
 
 

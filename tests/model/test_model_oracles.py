@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mtpg.model.graph import Population, atomic, check_invariants
+from mtpg.model.graph import InvariantError, Population, atomic, check_invariants
 from mtpg.model.instructions import (
     RegisterLayout,
     disassemble,
@@ -153,12 +153,12 @@ def test_in_degree_roots_reachable_and_banks() -> None:
     assert pop.reachable(0) == [0, 1, 2]
     assert pop.reachable(1) == [1, 2]
     assert pop.reachable(3) == [3]
-    assert pop.banks() == {0}
+    assert pop.banks() == [0]
     to0 = pop.add_program(CODE, 0, pop.new_bank()).id
     pop.teams[2].programs.append(to0)  # a cycle: 0 is no longer a root
     assert pop.roots() == [3]
     assert pop.reachable(2) == [2, 0, 1]
-    assert pop.banks() == {0, 1}
+    assert pop.banks() == [0, 1]
 
 
 def test_prune_deletes_only_programs_no_team_holds() -> None:
@@ -181,9 +181,12 @@ def test_prune_deletes_only_programs_no_team_holds() -> None:
         (lambda pop: pop.add_program(CODE, atomic(0), 0), "program 7 is held by no team"),
         (lambda pop: setattr(pop.programs[4], "action", 9), "program 4 points to missing team"),
         (lambda pop: setattr(pop.programs[0], "action", atomic(3)), "program 0 action -4"),
-        (lambda pop: setattr(pop.programs[0], "bank", 5), "program 0 bank 5"),
-        (lambda pop: setattr(pop.programs[0], "bank", 1), "program 0 bank 1"),  # next id
-        (lambda pop: setattr(pop.programs[0], "bank", -1), "program 0 bank -1"),
+        (lambda pop: setattr(pop.programs[0], "bank", 5), "program 0 points to missing bank 5"),
+        (
+            lambda pop: setattr(pop.programs[0], "bank", 1),
+            "program 0 points to missing bank 1",
+        ),  # next id
+        (lambda pop: setattr(pop.programs[0], "bank", -1), "program 0 points to missing bank -1"),
         (
             lambda pop: setattr(pop.programs[1], "instructions", np.array([[0, 40, 0, 0]])),
             "program 1: dst out of range",
@@ -198,5 +201,5 @@ def test_check_invariants_names_each_broken_rule(break_it, message) -> None:
     pop = chain()
     check_invariants(pop)
     break_it(pop)
-    with pytest.raises(AssertionError, match=message.replace("[", r"\[")):
+    with pytest.raises(InvariantError, match=message.replace("[", r"\[")):
         check_invariants(pop)

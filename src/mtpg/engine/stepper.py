@@ -46,6 +46,63 @@ def _record(t, W, team_stamp, stamp, bank_stamp, episode, base, M, memory, team_
 
 
 @njit(cache=True, error_model="numpy")
+def _step(
+    t,
+    root,
+    episode,
+    no_memory,
+    W,
+    team_stamp,
+    bank_stamp,
+    counts,
+    actions,
+    teams,
+    n_instr,
+    memory,
+    team_log,
+    n_log,
+    team_offsets,
+    team_members,
+    prog_offsets,
+    instrs,
+    prog_action,
+    prog_bank,
+    R,
+    M,
+    base,
+):  # noqa: N803
+    """Decision ``t`` with the production ``decide``, its outputs written into row ``t``."""
+    counts[:] = 0
+    a_d, a_c = decide(
+        root,
+        W,
+        team_stamp,
+        t,
+        bank_stamp,
+        episode,
+        no_memory,
+        counts,
+        team_offsets,
+        team_members,
+        prog_offsets,
+        instrs,
+        prog_action,
+        prog_bank,
+        R,
+        M,
+        base,
+    )
+    actions[t, 0] = a_d
+    actions[t, 1] = a_c
+    teams[t] = counts[0]
+    n_instr[t] = counts[1]
+    team_log, n_log = _record(
+        t, W, team_stamp, t, bank_stamp, episode, base, M, memory, team_log, n_log
+    )
+    return a_d, a_c, team_log, n_log
+
+
+@njit(cache=True, error_model="numpy")
 def step_sequence(
     root,
     obs_seq,
@@ -84,16 +141,21 @@ def step_sequence(
     for t in range(n):
         obs[0] = obs_seq[t, 0]
         obs[1] = obs_seq[t, 1]
-        counts[:] = 0
-        a_d, a_c = decide(
-            root,
-            W,
-            team_stamp,
+        a_d, a_c, team_log, n_log = _step(
             t,
-            bank_stamp,
+            root,
             episode_of_step[t],
             no_memory,
+            W,
+            team_stamp,
+            bank_stamp,
             counts,
+            actions,
+            teams,
+            n_instr,
+            memory,
+            team_log,
+            n_log,
             team_offsets,
             team_members,
             prog_offsets,
@@ -103,13 +165,6 @@ def step_sequence(
             R,
             M,
             base,
-        )
-        actions[t, 0] = a_d
-        actions[t, 1] = a_c
-        teams[t] = counts[0]
-        n_instr[t] = counts[1]
-        team_log, n_log = _record(
-            t, W, team_stamp, t, bank_stamp, episode_of_step[t], base, M, memory, team_log, n_log
         )
     return actions, teams, n_instr, memory, team_log[:n_log]
 
@@ -158,16 +213,21 @@ def step_episode(
     while t < n:
         observations[t, 0] = obs[0]
         observations[t, 1] = obs[1]
-        counts[:] = 0
-        a_d, a_c = decide(
-            root,
-            W,
-            team_stamp,
+        a_d, a_c, team_log, n_log = _step(
             t,
-            bank_stamp,
+            root,
             0,
             no_memory,
+            W,
+            team_stamp,
+            bank_stamp,
             counts,
+            actions,
+            teams,
+            n_instr,
+            memory,
+            team_log,
+            n_log,
             team_offsets,
             team_members,
             prog_offsets,
@@ -177,13 +237,6 @@ def step_episode(
             R,
             M,
             base,
-        )
-        actions[t, 0] = a_d
-        actions[t, 1] = a_c
-        teams[t] = counts[0]
-        n_instr[t] = counts[1]
-        team_log, n_log = _record(
-            t, W, team_stamp, t, bank_stamp, 0, base, M, memory, team_log, n_log
         )
         reward, terminated, truncated = env_step(task, params, state, a_d, a_c)
         rewards[t] = reward

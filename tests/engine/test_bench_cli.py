@@ -2,7 +2,10 @@
 
 import json
 
+import pytest
+
 from mtpg.cli.main import main
+from mtpg.export.harness import find_compiler
 
 KEYS = {
     "decisions_per_s",
@@ -12,22 +15,23 @@ KEYS = {
     "reference_decisions_per_s",
     "pytpg_decisions_per_s",
     "graphs",
-    "steps",
+    "episodes",
     "seconds",
     "machine",
 }
 
 
 def test_bench_engine_prints_json_last(capsys):
-    argv = ["bench", "engine", "--graphs", "20", "--steps", "50", "--repeats", "1"]
+    argv = ["bench", "engine", "--graphs", "20", "--episodes", "3", "--repeats", "1"]
     code = main([*argv, "--reference-graphs", "2", "--no-pytpg"])
     assert code == 0
     lines = capsys.readouterr().out.strip().splitlines()
     result = json.loads(lines[-1])
     assert KEYS <= set(result)
     assert result["threads"] == 1
-    assert result["graphs"] == 20 and result["steps"] == 50
-    assert result["decisions"] == 20 * 50
+    assert result["graphs"] == 20 and result["episodes"] == 3
+    assert result["decisions"] >= 20 * 3
+    assert result["engine_vs_c"] is None
     assert result["decisions_per_s"] > 0
     assert result["reference_decisions_per_s"] > 0
     assert result["pytpg_decisions_per_s"] is None
@@ -36,6 +40,18 @@ def test_bench_engine_prints_json_last(capsys):
 
 
 def test_bench_engine_rejects_bad_threads(capsys):
-    code = main(["bench", "engine", "--graphs", "2", "--steps", "5", "--threads", "0"])
+    code = main(["bench", "engine", "--graphs", "2", "--episodes", "5", "--threads", "0"])
     assert code == 2
     assert "threads" in capsys.readouterr().err
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+def test_bench_engine_c_port_matches_and_is_timed(capsys):
+    """``--c`` checks the C port against the engine job by job, then times both."""
+    argv = ["bench", "engine", "--graphs", "30", "--episodes", "2", "--repeats", "2", "--c"]
+    assert main([*argv, "--reference-graphs", "0", "--no-pytpg"]) == 0
+    out = capsys.readouterr().out
+    assert "equal the engine's" in out
+    result = json.loads(out.strip().splitlines()[-1])
+    assert result["c_decisions_per_s"] > 0 and result["engine_vs_c"] > 0
+    assert len(result["engine_vs_c_all"]) == 2

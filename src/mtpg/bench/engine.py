@@ -12,13 +12,16 @@ from __future__ import annotations
 import os
 import platform
 import statistics
+import tempfile
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numba
 import numpy as np
 
-from mtpg.bench.workload import Workload, drive, episode_row, make_workload, warm_up
+from mtpg.bench.workload import Workload, drive, make_workload, warm_up
+from mtpg.engine.batch import BatchResult
 from mtpg.engine.reference import ReferenceAgent
 from mtpg.envs import CARTPOLE, TASK_PARAMS, env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE
@@ -33,64 +36,63 @@ class ReferenceRun:
     Attributes:
         decisions: Decisions made.
         seconds: Time spent inside ``ReferenceAgent.act``.
-        actions: int8 ``[graphs, steps]`` discrete actions.
-        observations: float64 ``[graphs, steps, 2]`` the observation of every decision.
+        result: Per-job outcomes of the played jobs (teams and instructions are 0: the
+            reference interpreter does not count them).
+        observations: Per graph, float64 ``[decisions, 2]`` the observation of every decision.
     """
 
     decisions: int
     seconds: float
-    actions: np.ndarray
-    observations: np.ndarray
+    result: BatchResult
+    observations: list[np.ndarray]
 
 
 def run_reference(work: Workload, graphs: int) -> ReferenceRun:
-    """Plays the first ``graphs`` graphs with the reference interpreter.
+    """Plays the jobs of the first ``graphs`` graphs with the reference interpreter.
 
-    Episodes follow the same pool rows as :func:`drive_strided`; only the calls to
-    ``act`` are timed.
+    The episodes are those of the same jobs in the workload; only the calls to ``act``
+    are timed.
 
     Args:
         work: The workload.
         graphs: Number of leading graphs to play.
 
     Returns:
-        Decisions, time, actions and observations.
+        Decisions, time, per-job outcomes and observations.
     """
     graphs = min(graphs, work.n_graphs)
-    steps = work.steps
-    actions = np.zeros((graphs, steps), np.int8)
-    observations = np.zeros((graphs, steps, 2))
+    n_jobs = graphs * work.episodes
+    returns, steps = np.zeros(n_jobs), np.zeros(n_jobs, np.int64)
+    observations = []
     state = np.zeros(STATE_SIZE)
     obs = np.zeros(2)
-    n_pool = len(work.starts)
     seconds = 0.0
     clock = time.perf_counter
     for g in range(graphs):
         agent = ReferenceAgent(work.pop, work.root_ids[g])
-        agent.reset()
-        k = 0
-        e = episode_row(g, k, work.n_graphs, n_pool)
-        env_reset(CARTPOLE, TASK_PARAMS, work.starts[e], state)
-        env_observe(CARTPOLE, TASK_PARAMS, state, work.noise[e, 0], obs)
-        t = 0
-        for s in range(steps):
-            observations[g, s] = obs
-            t0 = clock()
-            d = agent.act(obs)
-            seconds += clock() - t0
-            actions[g, s] = d.action
-            _, terminated, truncated = env_step(
-                CARTPOLE, TASK_PARAMS, state, d.action, d.continuous
-            )
-            t += 1
-            if terminated or truncated:
-                k += 1
-                e = episode_row(g, k, work.n_graphs, n_pool)
-                agent.reset()
-                env_reset(CARTPOLE, TASK_PARAMS, work.starts[e], state)
-                t = 0
-            env_observe(CARTPOLE, TASK_PARAMS, state, work.noise[e, t], obs)
-    return ReferenceRun(graphs * steps, seconds, actions, observations)
+        seen = []
+        for j in range(g * work.episodes, (g + 1) * work.episodes):
+            e = int(work.job_episodes[j])
+            agent.reset()
+            env_reset(CARTPOLE, TASK_PARAMS, work.pool.starts[e], state)
+            env_observe(CARTPOLE, TASK_PARAMS, state, work.pool.noise[e, 0], obs)
+            while True:
+                seen.append(obs.copy())
+                t0 = clock()
+                d = agent.act(obs)
+                seconds += clock() - t0
+                reward, terminated, truncated = env_step(
+                    CARTPOLE, TASK_PARAMS, state, d.action, d.continuous
+                )
+                returns[j] += reward
+                steps[j] += 1
+                if terminated or truncated:
+                    break
+                env_observe(CARTPOLE, TASK_PARAMS, state, work.pool.noise[e, steps[j]], obs)
+        observations.append(np.array(seen).reshape(-1, 2))
+    zeros = np.zeros(n_jobs, np.int64)
+    result = BatchResult(returns, steps, zeros, zeros.copy())
+    return ReferenceRun(int(steps.sum()), seconds, result, observations)
 
 
 def _pytpg_graph(pytpg_core, rng: np.random.Generator, pop: Population, root_id: int, layout):
@@ -180,9 +182,9 @@ def run_pytpg(work: Workload, reference: ReferenceRun, seed: int = 0) -> dict | 
     )
     decisions, teams, seconds = 0, 0, 0.0
     clock = time.perf_counter
-    for g in range(reference.observations.shape[0]):
+    for g, seen in enumerate(reference.observations):
         graph = _pytpg_graph(pytpg_core, rng, work.pop, work.root_ids[g], layout)
-        seq = [tuple(float(x) for x in o) for o in reference.observations[g]]
+        seq = [tuple(float(x) for x in o) for o in seen]
         t0 = clock()
         for o in seq:
             teams += len(runtime.traverse(graph, o).steps)
@@ -212,17 +214,44 @@ def machine_info() -> dict:
     }
 
 
+def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run):
+    """Times the C port interleaved with the engine: C, engine, C, engine, ...
+
+    Returns:
+        ``(c_cpu_seconds, engine_cpu_seconds)`` per repeat, or None without a compiler.
+    """
+    from mtpg.bench import c_port
+
+    if c_port.find_compiler() is None:
+        say("no C compiler: the C port is not timed")
+        return None
+    with tempfile.TemporaryDirectory(prefix="mtpg-bench-") as tmp:
+        exe = c_port.build(Path(tmp))
+        data = Path(tmp) / "workload.bin"
+        c_port.write_input(work, data)
+        first = c_port.run_port(exe, data, len(work.job_roots))
+        c_port.check(engine, first.result)
+        say("C port: every job's return, steps, teams and instructions equal the engine's")
+        c_cpu, e_cpu = [], []
+        for r in range(repeats):
+            c_cpu.append(c_port.run_port(exe, data, len(work.job_roots)).cpu_seconds)
+            e_cpu.append(engine_run().cpu_seconds)
+            say(f"  pair {r + 1}/{repeats}: C {c_cpu[-1]:.3f} s, engine {e_cpu[-1]:.3f} s CPU")
+    return c_cpu, e_cpu
+
+
 def benchmark(
     graphs: int = 3000,
     teams: int = 3,
     programs: int = 10,
     instructions: int = 10,
-    steps: int = 300,
+    episodes: int = 16,
     threads: int = 1,
     repeats: int = 3,
     seed: int = 0,
     reference_graphs: int = 20,
     pytpg: bool = True,
+    c: bool = False,
     log=None,
 ) -> dict:
     """Runs the whole benchmark.
@@ -232,12 +261,15 @@ def benchmark(
         teams: Teams per graph.
         programs: Programs per team.
         instructions: Instructions per program.
-        steps: Decisions per graph.
+        episodes: CartPole episodes per graph.
         threads: Numba threads of the compiled runs.
         repeats: Timed compiled runs; the median is reported.
         seed: Workload seed.
         reference_graphs: Graphs played by the reference interpreter and by pytpg.
         pytpg: Time pytpg too (when installed).
+        c: Also time the same work in hand-written C (:mod:`mtpg.bench.c_port`), checked
+            bit for bit against the engine and run interleaved with one-thread engine runs
+            (process CPU time of both).
         log: Called with progress lines (``None``: silent).
 
     Returns:
@@ -251,35 +283,43 @@ def benchmark(
     say("compiling kernels ...")
     warm_up(threads)
     say(f"building {graphs} graphs ...")
-    work = make_workload(graphs, teams, programs, instructions, steps, seed)
-    record = min(reference_graphs, graphs)
+    work = make_workload(graphs, teams, programs, instructions, episodes, seed)
     runs = []
     for r in range(repeats):
-        res = drive(work, threads, record)
+        res = drive(work, threads)
         runs.append(res)
-        say(f"  run {r + 1}/{repeats}: {graphs * steps / res.seconds:,.0f} decisions/s")
-    first = runs[0]
+        say(f"  run {r + 1}/{repeats}: {res.decisions / res.seconds:,.0f} decisions/s")
+    first = runs[0].result
     for res in runs[1:]:
-        if not np.array_equal(res.instructions, first.instructions):
+        if not np.array_equal(res.result.instructions, first.instructions):
             raise RuntimeError("compiled runs disagree between repeats")
     seconds = statistics.median(r.seconds for r in runs)
-    decisions = graphs * steps
+    decisions = runs[0].decisions
+    record = min(reference_graphs, graphs)
     ref = None
     if record:
         say(f"reference interpreter on {record} graphs ...")
         ref = run_reference(work, record)
-        if not np.array_equal(ref.actions, first.actions):
+        played = slice(0, record * episodes)
+        if not (
+            np.array_equal(ref.result.steps, first.steps[played])
+            and np.array_equal(ref.result.returns, first.returns[played])
+        ):
             raise RuntimeError("reference interpreter and compiled engine disagree")
     pt = None
     if pytpg and ref is not None:
         say(f"pytpg on {record} graphs ...")
         pt = run_pytpg(work, ref, seed)
+    c_pairs = None
+    if c:
+        say("the same work in C (interleaved with one-thread engine runs) ...")
+        c_pairs = _c_runs(work, first, repeats, say, lambda: drive(work, 1))
     rate = decisions / seconds
     ref_rate = ref.decisions / ref.seconds if ref is not None and ref.seconds > 0 else None
     pt_rate = pt["decisions"] / pt["seconds"] if pt and pt["seconds"] > 0 else None
     executed = int(first.instructions.sum())
     total_instr = int(work.cp.n_instructions.sum())
-    return {
+    out = {
         "decisions_per_s": rate,
         "instructions_per_decision": executed / decisions,
         "teams_per_decision": int(first.teams.sum()) / decisions,
@@ -290,13 +330,15 @@ def benchmark(
         "speedup_vs_reference": rate / ref_rate if ref_rate else None,
         "speedup_vs_pytpg": rate / pt_rate if pt_rate else None,
         "pytpg_teams_per_decision": pt["teams"] / pt["decisions"] if pt else None,
+        "c_decisions_per_s": None,
+        "engine_cpu_decisions_per_s": None,
+        "engine_vs_c": None,
         "graphs": graphs,
         "teams": teams,
         "programs": programs,
         "instructions": instructions,
-        "steps": steps,
+        "episodes": episodes,
         "decisions": decisions,
-        "episodes": int(first.episodes.sum()),
         "pointer_fraction": work.pointer_fraction,
         "effective_instruction_fraction": len(work.cp.instrs) / total_instr,
         "repeats": repeats,
@@ -307,3 +349,11 @@ def benchmark(
         "seed": seed,
         "machine": machine_info(),
     }
+    if c_pairs is not None:
+        c_cpu, e_cpu = c_pairs
+        ratios = [cc / ee for cc, ee in zip(c_cpu, e_cpu, strict=True)]
+        out["c_decisions_per_s"] = decisions / statistics.median(c_cpu)
+        out["engine_cpu_decisions_per_s"] = decisions / statistics.median(e_cpu)
+        out["engine_vs_c"] = statistics.median(ratios)
+        out["engine_vs_c_all"] = ratios
+    return out

@@ -21,17 +21,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=(
             "Times the compiled engine on a fixed, seeded workload: random graphs of "
             "TEAMS x PROGRAMS x INSTRUCTIONS (about 40% of programs pointing to a later "
-            "team), each driving CartPole for STEPS decisions with automatic resets. "
-            "The Python reference interpreter and, when installed, the pytpg package are "
-            "timed on the first REFERENCE_GRAPHS graphs. Prints a summary, then one JSON "
-            "object as the last line."
+            "team), each playing EPISODES CartPole episodes, run by the batch kernel "
+            "training uses. The Python reference interpreter and, when installed, the "
+            "pytpg package are timed on the first REFERENCE_GRAPHS graphs; with --c, the "
+            "same work in hand-written C is checked bit for bit and timed against the "
+            "engine. Prints a summary, then one JSON object as the last line."
         ),
     )
     eng.add_argument("--graphs", type=int, default=3000, help="number of graphs (3000)")
     eng.add_argument("--teams", type=int, default=3, help="teams per graph (3)")
     eng.add_argument("--programs", type=int, default=10, help="programs per team (10)")
     eng.add_argument("--instructions", type=int, default=10, help="instructions per program (10)")
-    eng.add_argument("--steps", type=int, default=300, help="decisions per graph (300)")
+    eng.add_argument("--episodes", type=int, default=16, help="CartPole episodes per graph (16)")
     eng.add_argument("--threads", type=int, default=1, help="Numba threads (1)")
     eng.add_argument("--repeats", type=int, default=3, help="timed runs, median reported (3)")
     eng.add_argument("--seed", type=int, default=0, help="workload seed (0)")
@@ -42,6 +43,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="graphs played by the reference interpreter and pytpg (20)",
     )
     eng.add_argument("--no-pytpg", action="store_true", help="do not time pytpg")
+    eng.add_argument(
+        "--c",
+        action="store_true",
+        help="also time the same work in hand-written C (needs a C compiler), interleaved"
+        " with one-thread engine runs, process CPU time",
+    )
     eng.set_defaults(func=run)
     bench.set_defaults(func=lambda _args: _help(bench))
 
@@ -74,12 +81,13 @@ def run(args: argparse.Namespace) -> int:
         teams=args.teams,
         programs=args.programs,
         instructions=args.instructions,
-        steps=args.steps,
+        episodes=args.episodes,
         threads=args.threads,
         repeats=args.repeats,
         seed=args.seed,
         reference_graphs=args.reference_graphs,
         pytpg=not args.no_pytpg,
+        c=args.c,
         log=log,
     )
     m = r["machine"]
@@ -90,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
         f"mtpg engine benchmark ({m['cpu']}, {m['cores']} cores, numba {m['numba']})",
         f"  workload      {r['graphs']} graphs x {r['teams']} teams x {r['programs']} programs"
         f" x {r['instructions']} instructions, {r['pointer_fraction']:.1%} pointers,"
-        f" CartPole {r['steps']} steps each ({r['episodes']} episodes)",
+        f" {r['episodes']} CartPole episodes each",
         f"  compiled      {_fmt(r['decisions_per_s'])} decisions/s on {r['threads']} thread(s)"
         f" (median of {r['repeats']}: {r['seconds']:.3f} s for {r['decisions']:,} decisions,"
         " environment included)",
@@ -111,6 +119,13 @@ def run(args: argparse.Namespace) -> int:
         ),
         f"  setup         {r['build_seconds']:.1f} s to draw and compile the graphs",
     ]
+    if r["engine_vs_c"] is not None:
+        lines.insert(
+            -1,
+            f"  C             {_fmt(r['c_decisions_per_s'])} decisions/s (same work, checked bit"
+            f" for bit); engine {_fmt(r['engine_cpu_decisions_per_s'])} on 1 thread:"
+            f" {r['engine_vs_c']:.3f} of C (median of {r['repeats']} interleaved pairs, CPU time)",
+        )
     print("\n".join(lines))
     sys.stdout.flush()
     print(json.dumps(r))

@@ -17,8 +17,8 @@ import numpy as np
 from numba import njit, prange
 
 from mtpg.engine.ops import apply_op
-from mtpg.envs import env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE
+from mtpg.envs.kernels import env_observe_row, env_reset, env_step_row
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
 _CONSTANTS = CONSTANTS.copy()
@@ -43,7 +43,7 @@ def thread_buffers(team_offsets, prog_bank, R, M, base):  # noqa: N803
     return W, team_stamp, bank_stamp, np.zeros(STATE_SIZE), np.zeros(2, dtype=np.int64)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def decide(
     root,
     W,
@@ -66,7 +66,10 @@ def decide(
     """Makes one decision: traverses the graph from ``root`` to an atomic action.
 
     Written as one flat loop nest on purpose: helper functions taking arrays cost an
-    atomic reference-count update per call, about a fifth of the run time.
+    atomic reference-count update per call, about a fifth of the run time. It is inlined
+    into its callers (``inline="always"``, as is ``apply_op``), so a decision passes no
+    arguments (each array is seven machine words) and the instruction loop is compiled
+    in place.
 
     Each visited team runs all its programs in order, then follows the highest bid among
     programs whose pointer is atomic or leads to a team not yet visited in this decision
@@ -94,43 +97,54 @@ def decide(
     Returns:
         ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
     """
-    team = root
+    # Every index below is unsigned (np.uint64): Numba then emits plain loads and stores,
+    # without the fix-up for negative (from-the-end) indices that a signed index costs at
+    # every access (and that turned the bank reset into scatter stores).
+    one = np.uint64(1)
+    u_m = np.uint64(M)
+    u_base = np.uint64(base)
+    team = np.uint64(root)
+    # +0.0, computed from a constant register so that the compiler cannot see it is zero:
+    # zero stores of a known 0.0 are turned into a libc memset call per program run.
+    zero = W[R] - W[R]
     n_teams = 0
-    n_instr = 0
+    n_instr = np.uint64(0)
     while True:
         team_stamp[team] = stamp
         n_teams += 1
-        best_p = -1
+        found = False
+        best_p = np.uint64(0)
         best = 0.0
-        for k in range(team_offsets[team], team_offsets[team + 1]):
-            p = team_members[k]
-            bank = prog_bank[p]
+        for k in range(np.uint64(team_offsets[team]), np.uint64(team_offsets[team + one])):
+            p = np.uint64(team_members[k])
+            bank = np.uint64(prog_bank[p])
             if no_memory or bank_stamp[bank] != episode:  # lazy reset of the bank
-                off = base + bank * M
-                for j in range(M):
-                    W[off + j] = 0.0
+                off = u_base + bank * u_m
+                for j in range(off, off + u_m):
+                    W[j] = 0.0
                 bank_stamp[bank] = episode
-            if R == 8:  # the common size: plain stores instead of a memset call
-                W[0] = W[1] = W[2] = W[3] = W[4] = W[5] = W[6] = W[7] = 0.0
+            if R == 8:  # the common size: straight-line stores
+                W[0] = W[1] = W[2] = W[3] = W[4] = W[5] = W[6] = W[7] = zero
             else:
                 for i in range(R):
-                    W[i] = 0.0
-            lo, hi = prog_offsets[p], prog_offsets[p + 1]
+                    W[i] = zero
+            lo, hi = np.uint64(prog_offsets[p]), np.uint64(prog_offsets[p + one])
             for i in range(lo, hi):
                 dst = instrs[i, 1]
                 W[dst] = apply_op(instrs[i, 0], W[dst], W[instrs[i, 2]], W[instrs[i, 3]])
             n_instr += hi - lo
             bid = W[0]
             act = prog_action[p]
-            if (act < 0 or team_stamp[act] != stamp) and (best_p < 0 or bid > best):
+            if (act < 0 or team_stamp[np.uint64(act)] != stamp) and (not found or bid > best):
                 best = bid
                 best_p = p
+                found = True
         act = prog_action[best_p]
         if act < 0:
             counts[0] += n_teams
-            counts[1] += n_instr
-            return -1 - act, W[base + prog_bank[best_p] * M]
-        team = act
+            counts[1] += np.int64(n_instr)
+            return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m]
+        team = np.uint64(act)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -172,8 +186,9 @@ def run_jobs_strided(
     for j in range(chunk, len(job_root), n_chunks):
         e = job_ep[j]
         task = ep_task[e]
+        p = params[task]  # the parameter row, taken once per episode
         env_reset(task, params, ep_start[e], state)
-        env_observe(task, params, state, ep_noise[e, 0], obs)
+        env_observe_row(task, p, state, ep_noise[e, 0], obs)
         counts[:] = 0
         total = 0.0
         t = 0
@@ -198,12 +213,12 @@ def run_jobs_strided(
                 base,
             )
             stamp += 1
-            reward, terminated, truncated = env_step(task, params, state, a_d, a_c)
+            reward, terminated, truncated = env_step_row(task, p, state, a_d, a_c)
             total += reward
             t += 1
             if terminated or truncated:
                 break
-            env_observe(task, params, state, ep_noise[e, t], obs)
+            env_observe_row(task, p, state, ep_noise[e, t], obs)
         out_return[j] = total
         out_steps[j] = t
         out_teams[j] = counts[0]

@@ -57,7 +57,18 @@ def env_observe(
         noise: The episode's U[0, 1] noise value for this step (used by one-input tasks).
         obs: Output array of at least two slots.
     """
-    p = params[task]
+    env_observe_row(task, params[task], state, noise, obs)
+
+
+@njit(cache=True, error_model="numpy")
+def env_observe_row(
+    task: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
+) -> None:
+    """:func:`env_observe` given the task's parameter row ``p = params[task]``.
+
+    The batch kernel takes the row once per episode: making it (an array view) at every
+    step costs reference-count updates.
+    """
     if task == CARTPOLE:
         cartpole.observe(p, state, noise, obs)
     elif task == ACROBOT:
@@ -87,7 +98,18 @@ def env_step(
         (reward, terminated, truncated); truncated is True when the step count reaches the
         task's time limit without termination.
     """
-    p = params[task]
+    return env_step_row(task, params[task], state, a_d, a_c)
+
+
+@njit(cache=True, error_model="numpy")
+def env_step_row(
+    task: int, p: np.ndarray, state: np.ndarray, a_d: int, a_c: float
+) -> tuple[float, bool, bool]:
+    """:func:`env_step` given the task's parameter row ``p = params[task]``.
+
+    The batch kernel takes the row once per episode: making it (an array view) at every
+    step costs reference-count updates.
+    """
     state[STEP_SLOT] += 1.0
     if task == CARTPOLE:
         reward, terminated = cartpole.step(p, state, a_d)

@@ -10,11 +10,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from decide_stepper import play_episode, production_steps
 from mtpg.config import build_config
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.reference import ReferenceAgent
-from mtpg.engine.stepper import play_episode, production_steps
 from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE, TASK_NAMES

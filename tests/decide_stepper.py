@@ -1,5 +1,9 @@
 """Step-by-step outputs of the production decision kernel, for the parity tests.
 
+This driver is test support and lives with the tests: the package's one episode loop is
+:func:`mtpg.engine.kernels.run_jobs_strided` (training, testing and the benchmark), besides
+the instrumented tracer of :mod:`mtpg.engine.trace` that the analyses use.
+
 Training and testing call :func:`mtpg.engine.kernels.decide` from the batch kernels, which
 return only per-episode totals. The drivers here call that same ``decide`` (no second copy
 of its logic), with the same per-thread buffers and the same lazy bank reset, one decision

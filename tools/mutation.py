@@ -370,8 +370,8 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "kernel-tie-to-later-program",
         "src/mtpg/engine/kernels.py",
-        "(best_p < 0 or bid > best)",
-        "(best_p < 0 or bid >= best)",
+        "(not found or bid > best)",
+        "(not found or bid >= best)",
         _ENGINE,
     ),
     HandMutant(
@@ -391,8 +391,8 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "kernel-continuous-output-register",
         "src/mtpg/engine/kernels.py",
-        "return -1 - act, W[base + prog_bank[best_p] * M]",
-        "return -1 - act, W[base + prog_bank[best_p] * M + 1]",
+        "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m]",
+        "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m + one]",
         _ENGINE,
     ),
 )

@@ -389,6 +389,20 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
         _ENGINE,
     ),
     HandMutant(
+        "kernel-time-limit-one-late",
+        "src/mtpg/engine/kernels.py",
+        "truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]",
+        "truncated = (not terminated) and state[STEP_SLOT] > p[P_MAX_STEPS]",
+        _ENGINE,
+    ),
+    HandMutant(
+        "kernel-dispatch-swaps-tasks",
+        "src/mtpg/engine/kernels.py",
+        "reward, terminated = mountaincar.step_discrete(p, state, a_d)",
+        "reward, terminated = mountaincar.step_continuous(p, state, a_c)",
+        _ENGINE,
+    ),
+    HandMutant(
         "kernel-continuous-output-register",
         "src/mtpg/engine/kernels.py",
         "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m]",

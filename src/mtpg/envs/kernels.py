@@ -97,19 +97,12 @@ def env_step(
     Returns:
         (reward, terminated, truncated); truncated is True when the step count reaches the
         task's time limit without termination.
+
+    The batch kernel (:func:`mtpg.engine.kernels.run_jobs_strided`) repeats this dispatch
+    in its episode loop, for speed; the two must stay the same (the engine's parity tests
+    play every task through both).
     """
-    return env_step_row(task, params[task], state, a_d, a_c)
-
-
-@njit(cache=True, error_model="numpy")
-def env_step_row(
-    task: int, p: np.ndarray, state: np.ndarray, a_d: int, a_c: float
-) -> tuple[float, bool, bool]:
-    """:func:`env_step` given the task's parameter row ``p = params[task]``.
-
-    The batch kernel takes the row once per episode: making it (an array view) at every
-    step costs reference-count updates.
-    """
+    p = params[task]
     state[STEP_SLOT] += 1.0
     if task == CARTPOLE:
         reward, terminated = cartpole.step(p, state, a_d)

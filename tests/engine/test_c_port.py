@@ -36,3 +36,9 @@ def test_check_names_the_first_differing_job(port, tmp_path):
     run.result.instructions[7] += 1
     with pytest.raises(RuntimeError, match="job 7's instructions"):
         c_port.check(engine, run.result)
+
+
+@pytest.mark.parametrize("flags", [("-Ofast",), ("-O2", "-ffast-math")])
+def test_fast_math_yardstick_is_refused(tmp_path, flags):
+    with pytest.raises(ValueError, match="fast-math"):
+        c_port.build(tmp_path, flags=flags)

@@ -29,7 +29,8 @@ from mtpg.envs import CARTPOLE, TASK_PARAMS
 from mtpg.export.harness import STRICT_FLAGS, find_compiler
 from mtpg.model.instructions import BIG, CONSTANTS, DIV_EPS, LOG_BIG, LOG_TINY
 
-#: Optimisation flags of the C yardstick (no fast-math, no contraction: IEEE results).
+#: Default optimisation flags of the C yardstick (never fast-math; no contraction, so the
+#: results are IEEE double arithmetic like the engine's).
 C_FLAGS = ("-O2", "-march=native")
 
 
@@ -51,12 +52,13 @@ def source() -> str:
     return files("mtpg.bench").joinpath("engine_port.c").read_text(encoding="utf-8")
 
 
-def build(directory: Path, compiler: str | None = None) -> Path:
+def build(directory: Path, compiler: str | None = None, flags: tuple[str, ...] = C_FLAGS) -> Path:
     """Compiles the C program into ``directory``.
 
     Args:
         directory: Where the source and executable are written.
         compiler: The compiler (default: ``$CC``, ``cc``, ``gcc`` or ``clang``).
+        flags: Optimisation flags, added to ``STRICT_FLAGS`` (which forbid contraction).
 
     Returns:
         The executable.
@@ -71,7 +73,9 @@ def build(directory: Path, compiler: str | None = None) -> Path:
     src = directory / "engine_port.c"
     src.write_text(source(), encoding="utf-8")
     exe = directory / "engine_port"
-    cmd = [cc, *STRICT_FLAGS, *C_FLAGS, str(src), "-o", str(exe), "-lm"]
+    if any("fast-math" in f or f == "-Ofast" for f in flags):
+        raise ValueError("the C yardstick must not use fast-math: results would differ")
+    cmd = [cc, *STRICT_FLAGS, *flags, str(src), "-o", str(exe), "-lm"]
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{done.stdout}{done.stderr}")

@@ -1,10 +1,12 @@
 """The engine benchmark behind ``mtpg bench engine``: baselines and the summary.
 
-The workload and the compiled driver live in :mod:`mtpg.bench.workload`. Besides
-the compiled engine, two baselines are timed on the first graphs of the workload: the
-plain-Python reference interpreter (its actions are checked against the compiled run, so
-both play the very same episodes) and, when installed, the ``pytpg`` package on graphs of
-the same shape fed the recorded observations.
+The workload and its compiled run (the engine's own batch kernel) live in
+:mod:`mtpg.bench.workload`. Besides the compiled engine, three baselines can be timed:
+the plain-Python reference interpreter on the first graphs (it plays the very same jobs,
+and every return and episode length is checked against the compiled run), the ``pytpg``
+package when installed (graphs of the same shape fed the recorded observations), and with
+``c=True`` the same work in hand-written C (:mod:`mtpg.bench.c_port`), checked job by job
+and timed interleaved with one-thread engine runs.
 """
 
 from __future__ import annotations
@@ -214,7 +216,7 @@ def machine_info() -> dict:
     }
 
 
-def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run):
+def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, flags):
     """Times the C port interleaved with the engine: C, engine, C, engine, ...
 
     Returns:
@@ -226,7 +228,8 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run):
         say("no C compiler: the C port is not timed")
         return None
     with tempfile.TemporaryDirectory(prefix="mtpg-bench-") as tmp:
-        exe = c_port.build(Path(tmp))
+        exe = c_port.build(Path(tmp), flags=flags)
+        say(f"C port compiled with {' '.join(flags)}")
         data = Path(tmp) / "workload.bin"
         c_port.write_input(work, data)
         first = c_port.run_port(exe, data, len(work.job_roots))
@@ -252,6 +255,7 @@ def benchmark(
     reference_graphs: int = 20,
     pytpg: bool = True,
     c: bool = False,
+    c_flags: tuple[str, ...] | None = None,
     log=None,
 ) -> dict:
     """Runs the whole benchmark.
@@ -270,6 +274,7 @@ def benchmark(
         c: Also time the same work in hand-written C (:mod:`mtpg.bench.c_port`), checked
             bit for bit against the engine and run interleaved with one-thread engine runs
             (process CPU time of both).
+        c_flags: Optimisation flags of the C build (default ``c_port.C_FLAGS``).
         log: Called with progress lines (``None``: silent).
 
     Returns:
@@ -313,7 +318,10 @@ def benchmark(
     c_pairs = None
     if c:
         say("the same work in C (interleaved with one-thread engine runs) ...")
-        c_pairs = _c_runs(work, first, repeats, say, lambda: drive(work, 1))
+        from mtpg.bench.c_port import C_FLAGS
+
+        c_flags = tuple(c_flags) if c_flags else C_FLAGS
+        c_pairs = _c_runs(work, first, repeats, say, lambda: drive(work, 1), c_flags)
     rate = decisions / seconds
     ref_rate = ref.decisions / ref.seconds if ref is not None and ref.seconds > 0 else None
     pt_rate = pt["decisions"] / pt["seconds"] if pt and pt["seconds"] > 0 else None
@@ -356,4 +364,5 @@ def benchmark(
         out["engine_cpu_decisions_per_s"] = decisions / statistics.median(e_cpu)
         out["engine_vs_c"] = statistics.median(ratios)
         out["engine_vs_c_all"] = ratios
+        out["c_flags"] = " ".join(c_flags)
     return out

@@ -49,6 +49,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="also time the same work in hand-written C (needs a C compiler), interleaved"
         " with one-thread engine runs, process CPU time",
     )
+    eng.add_argument(
+        "--c-flags",
+        default="-O2 -march=native",
+        help="optimisation flags of the C build ('-O2 -march=native'; fast-math refused)",
+    )
     eng.set_defaults(func=run)
     bench.set_defaults(func=lambda _args: _help(bench))
 
@@ -88,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
         reference_graphs=args.reference_graphs,
         pytpg=not args.no_pytpg,
         c=args.c,
+        c_flags=tuple(args.c_flags.split()),
         log=log,
     )
     m = r["machine"]
@@ -124,7 +130,8 @@ def run(args: argparse.Namespace) -> int:
             -1,
             f"  C             {_fmt(r['c_decisions_per_s'])} decisions/s (same work, checked bit"
             f" for bit); engine {_fmt(r['engine_cpu_decisions_per_s'])} on 1 thread:"
-            f" {r['engine_vs_c']:.3f} of C (median of {r['repeats']} interleaved pairs, CPU time)",
+            f" {r['engine_vs_c']:.3f} of C (median of {r['repeats']} interleaved pairs, CPU time;"
+            f" C built with {r['c_flags']})",
         )
     print("\n".join(lines))
     sys.stdout.flush()

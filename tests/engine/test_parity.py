@@ -128,6 +128,20 @@ def test_serial_and_parallel_batches_are_bit_identical():
     job_eps = np.tile(np.arange(len(episodes.tasks)), len(roots))[perm]
     shuffled = run_jobs(cp, job_roots, job_eps, episodes, threads=2)
     assert np.array_equal(shuffled.returns, serial.ravel()[perm])
+    # nor how jobs are dealt out in blocks, serially or over threads
+    for threads, block in [(1, 5), (2, 1), (2, 7), (2, 10_000)]:
+        dealt = run_jobs(cp, job_roots, job_eps, episodes, threads=threads, block=block)
+        assert dealt.returns.tobytes() == shuffled.returns.tobytes()
+        assert np.array_equal(dealt.instructions, shuffled.instructions)
+
+
+def test_bad_block_is_refused():
+    rng = np.random.default_rng(4)
+    pop, roots = layered_graphs(rng, 2, teams=1, programs=2, instructions=2)
+    cp = compile_population(pop)
+    episodes = Episodes.grid([0], [0])
+    with pytest.raises(ValueError, match="block"):
+        run_jobs(cp, np.array([cp.team_index(roots[0])]), np.array([0]), episodes, block=0)
 
 
 def test_no_memory_mode_differs_only_by_memory():

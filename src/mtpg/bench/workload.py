@@ -187,7 +187,9 @@ def drive(work: Workload, threads: int = 1) -> DriveResult:
         The per-job outcomes, the wall time and the process CPU time.
     """
     c0, t0 = time.process_time(), time.perf_counter()
-    result = run_jobs(work.cp, work.job_roots, work.job_episodes, work.pool, threads)
+    result = run_jobs(
+        work.cp, work.job_roots, work.job_episodes, work.pool, threads, block=work.episodes
+    )
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     return DriveResult(result, seconds, cpu)
 

@@ -73,6 +73,7 @@ def run_jobs(
     episodes: Episodes,
     threads: int = 1,
     no_memory: bool = False,
+    block: int = 1,
 ) -> BatchResult:
     """Plays every job ``(root, episode)`` in one compiled call.
 
@@ -86,12 +87,17 @@ def run_jobs(
         episodes: The episode table.
         threads: Numba threads to use (1: serial kernel, no thread pool).
         no_memory: Zero each bank before every program execution (ablation).
+        block: Jobs dealt out together to one chunk (see ``run_jobs_strided``); the
+            number of jobs per root keeps each root's episodes on one thread, in order.
+            Results do not depend on it.
 
     Returns:
         The per-job outcomes.
     """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
+    if block < 1:
+        raise ValueError(f"block must be >= 1, got {block}")
     n = len(job_roots)
     out = BatchResult(
         np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64)
@@ -111,10 +117,10 @@ def run_jobs(
         *cp.kernel_args(),
     )
     if threads == 1:
-        run_jobs_strided(0, 1, *args)
+        run_jobs_strided(0, 1, block, *args)
     else:
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-        run_jobs_parallel(threads * CHUNKS_PER_THREAD, *args)
+        run_jobs_parallel(threads * CHUNKS_PER_THREAD, block, *args)
     return out
 
 
@@ -142,5 +148,5 @@ def evaluate_roots(
     n_ep = len(episodes.tasks)
     job_roots = np.repeat(roots, n_ep)
     job_eps = np.tile(np.arange(n_ep, dtype=np.int64), len(roots))
-    result = run_jobs(cp, job_roots, job_eps, episodes, threads, no_memory)
+    result = run_jobs(cp, job_roots, job_eps, episodes, threads, no_memory, block=max(n_ep, 1))
     return result.returns.reshape(len(roots), n_ep), result

@@ -75,7 +75,7 @@ def play_batch(
     """
     n = len(job_roots)
     out = (np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
-    run_jobs_strided(0, 1, job_roots, job_eps, *table, TASK_PARAMS, no_memory, *out, *graph)
+    run_jobs_strided(0, 1, 1, job_roots, job_eps, *table, TASK_PARAMS, no_memory, *out, *graph)
     return out
 
 

@@ -161,6 +161,7 @@ def decide(
 def run_jobs_strided(
     chunk,
     n_chunks,
+    block,
     job_root,
     job_ep,
     ep_task,
@@ -182,7 +183,12 @@ def run_jobs_strided(
     M,
     base,
 ):  # noqa: N803
-    """Runs jobs ``chunk, chunk + n_chunks, ...`` serially with one private workspace.
+    """Runs chunk ``chunk`` of ``n_chunks`` serially with one private workspace.
+
+    Jobs are dealt out in blocks of ``block`` consecutive jobs: the chunk runs blocks
+    ``chunk, chunk + n_chunks, ...``. Consecutive jobs usually share a root (all its
+    episodes), so a block keeps one graph's code and memory banks in cache, while dealing
+    blocks round-robin balances long and short episodes across chunks.
 
     Releases the GIL, so several Python threads (e.g. of one Dask worker) run it at once.
 
@@ -193,68 +199,71 @@ def run_jobs_strided(
     W, team_stamp, bank_stamp, state, counts = thread_buffers(team_offsets, prog_bank, R, M, base)  # noqa: N806
     obs = W[R + N_CONSTANTS : R + N_CONSTANTS + 2]
     stamp = 0
-    for j in range(chunk, len(job_root), n_chunks):
-        e = job_ep[j]
-        task = ep_task[e]
-        p = params[task]  # the parameter row, taken once per episode
-        env_reset(task, params, ep_start[e], state)
-        env_observe_row(task, p, state, ep_noise[e, 0], obs)
-        counts[:] = 0
-        total = 0.0
-        t = 0
-        while True:
-            a_d, a_c = decide(
-                job_root[j],
-                W,
-                team_stamp,
-                stamp,
-                bank_stamp,
-                j,
-                no_memory,
-                counts,
-                team_offsets,
-                team_members,
-                prog_offsets,
-                instrs,
-                prog_action,
-                prog_bank,
-                R,
-                M,
-                base,
-            )
-            stamp += 1
-            # The step of mtpg.envs.kernels.env_step, dispatched here rather than called:
-            # a call passing the state and parameter arrays costs four atomic reference
-            # count updates per step (about 4% of the one-thread run time), which a call
-            # from this loop does not. The parity tests run every task through this loop.
-            state[STEP_SLOT] += 1.0
-            if task == CARTPOLE:
-                reward, terminated = cartpole.step(p, state, a_d)
-            elif task == ACROBOT:
-                reward, terminated = acrobot.step(p, state, a_c)
-            elif task == CARTCENTERING:
-                reward, terminated = cartcentering.step(p, state, a_d)
-            elif task == PENDULUM:
-                reward, terminated = pendulum.step(p, state, a_c)
-            elif task == MOUNTAINCAR:
-                reward, terminated = mountaincar.step_discrete(p, state, a_d)
-            else:
-                reward, terminated = mountaincar.step_continuous(p, state, a_c)
-            truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]
-            total += reward
-            t += 1
-            if terminated or truncated:
-                break
-            env_observe_row(task, p, state, ep_noise[e, t], obs)
-        out_return[j] = total
-        out_steps[j] = t
-        out_teams[j] = counts[0]
-        out_instr[j] = counts[1]
+    n_jobs = len(job_root)
+    for first in range(chunk * block, n_jobs, n_chunks * block):
+        for j in range(first, min(first + block, n_jobs)):
+            e = job_ep[j]
+            task = ep_task[e]
+            p = params[task]  # the parameter row, taken once per episode
+            env_reset(task, params, ep_start[e], state)
+            env_observe_row(task, p, state, ep_noise[e, 0], obs)
+            counts[:] = 0
+            total = 0.0
+            t = 0
+            while True:
+                a_d, a_c = decide(
+                    job_root[j],
+                    W,
+                    team_stamp,
+                    stamp,
+                    bank_stamp,
+                    j,
+                    no_memory,
+                    counts,
+                    team_offsets,
+                    team_members,
+                    prog_offsets,
+                    instrs,
+                    prog_action,
+                    prog_bank,
+                    R,
+                    M,
+                    base,
+                )
+                stamp += 1
+                # The step of mtpg.envs.kernels.env_step, dispatched here rather than called:
+                # a call passing the state and parameter arrays costs four atomic reference
+                # count updates per step (about 4% of the one-thread run time), which a call
+                # from this loop does not. The parity tests run every task through this loop.
+                state[STEP_SLOT] += 1.0
+                if task == CARTPOLE:
+                    reward, terminated = cartpole.step(p, state, a_d)
+                elif task == ACROBOT:
+                    reward, terminated = acrobot.step(p, state, a_c)
+                elif task == CARTCENTERING:
+                    reward, terminated = cartcentering.step(p, state, a_d)
+                elif task == PENDULUM:
+                    reward, terminated = pendulum.step(p, state, a_c)
+                elif task == MOUNTAINCAR:
+                    reward, terminated = mountaincar.step_discrete(p, state, a_d)
+                else:
+                    reward, terminated = mountaincar.step_continuous(p, state, a_c)
+                truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]
+                total += reward
+                t += 1
+                if terminated or truncated:
+                    break
+                env_observe_row(task, p, state, ep_noise[e, t], obs)
+            out_return[j] = total
+            out_steps[j] = t
+            out_teams[j] = counts[0]
+            out_instr[j] = counts[1]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def run_jobs_parallel(
     n_chunks,
+    block,
     job_root,
     job_ep,
     ep_task,
@@ -281,6 +290,7 @@ def run_jobs_parallel(
         run_jobs_strided(
             c,
             n_chunks,
+            block,
             job_root,
             job_ep,
             ep_task,

@@ -127,3 +127,20 @@ def test_graph_files_record_the_memory_ablation(tmp_path, no_memory: bool) -> No
     ):
         _, _, meta = load_graph(path)
         assert meta["no_memory"] is no_memory
+
+
+def test_the_vary_point_comes_after_half_of_the_subsets_bred(monkeypatch) -> None:
+    cfg = tiny("generations=2", 'evaluation.tasks=["CartPole", "MountainCar", "Pendulum"]')
+    trainer = Trainer(cfg)
+    bred = []
+
+    def record(phase: str, generation: int) -> None:
+        if phase == "vary":
+            st = trainer.state
+            bred.append(len([r for r in st.population.roots() if r not in st.scores]))
+
+    monkeypatch.setattr(trainer_module, "point", record)
+    trainer.run_generation()
+    trainer.run_generation()
+    # 7 subsets: subsets 0, 1 and 2 have bred their 2 children each when subset 3 starts
+    assert bred == [3 * cfg.elites_per_subset] and cfg.elites_per_subset == 2

@@ -179,3 +179,15 @@ def test_identity_differing_in_no_named_field_says_identity(run_dir) -> None:
     with pytest.raises(CheckpointError) as err:
         load_state(run, minus_zero)
     assert re.search(r"config\.toml in identity\); refusing it", str(err.value))
+
+
+def test_run_identity_is_stable_and_recorded_in_every_payload(payload) -> None:
+    """Checkpoints of earlier versions must keep matching: the identity is pinned.
+
+    It is the first 16 hex digits of the SHA-256 of the identity fields as compact,
+    key-sorted JSON; changing that text (key order, separators, length) would make
+    every existing run refuse its own checkpoints.
+    """
+    assert run_identity(build_config("paper")) == "19fed709cd1053fd"
+    assert run_identity(build_config("demo")) == "c6607c29d97f52e0"
+    assert payload["run"] == run_identity(tiny())

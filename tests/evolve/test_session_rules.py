@@ -147,3 +147,5 @@ def test_run_all_asks_should_stop_before_each_generation(tmp_path) -> None:
     assert session.run_all(should_stop=should_stop) is False
     assert asked == [0, 1] and session.saved_generation == 1
     assert [g for g, _ in list_checkpoints(run)] == [1]
+    session.close()  # closing again (run_all closed it) is harmless
+    lock_dir(run).release()

@@ -323,6 +323,12 @@ def test_metrics_row_from_a_hand_made_result(seed: int) -> None:
     for k, task in enumerate(("CartPole", "MountainCar")):
         assert row[f"best_{task}"] == scores[:, k].max()
         assert row[f"median_{task}"] == float(np.median(scores[:, k]))
+    four = SimpleNamespace(
+        steps=np.array([2, 2]), teams=np.array([6, 6]), instructions=np.array([14, 14])
+    )
+    row = trainer._metrics([1, 2], four, (10.0, 11.0, 13.0, 14.0))
+    assert row["decisions"] == 4 and row["decisions_per_s"] == 2.0
+    assert row["teams_per_decision"] == 3.0 and row["instructions_per_decision"] == 7.0
     none = SimpleNamespace(steps=np.array([0]), teams=np.array([0]), instructions=np.array([0]))
     row = trainer._metrics([], none, (0.0, 1.0, 1.0, 1.0))
     assert row["teams_per_decision"] == 0.0 and row["decisions_per_s"] == 0.0

@@ -154,3 +154,96 @@ def test_graph_must_be_an_object_and_rebuilds_counters_from_its_ids() -> None:
     assert (pop.next_team_id, pop.next_program_id, pop.next_bank_id) == (2, 3, 3)
     assert pop.memory_banks == {0, 1, 2}
     assert pop.teams[1].programs == [2, 0] and pop.programs[2].action == 0
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "message"),
+    [
+        (["layout"], [], "layout must be a JSON object, got list"),
+        (["layout", "n_memory"], None, "layout is missing key 'n_memory'"),
+        (["layout", "n_registers"], 0, "layout.n_registers must be >= 1, got 0"),
+        (["layout", "x"], 1, "layout has unknown keys ['x']"),
+        (["layout", "n_obs"], 3, "layout.n_obs must be 2 (the tasks' interface), got 3"),
+        (["layout", "n_memory"], 257, "layout.n_memory must be <= 256, got 257"),
+        (["programs", 0, "instructions"], 5, "program 0 instructions must be a list, got int"),
+        (["programs", 0, "instructions"], [], "program 0 has no instructions"),
+        (
+            ["programs", 0, "instructions"],
+            [[1, 2], [1, 2, 3]],
+            "program 0 instructions are not [op, dst, src1, src2] rows",
+        ),
+        (
+            ["programs", 0, "instructions"],
+            [[1, 2, 3]],
+            "program 0 instructions must be [op, dst, src1, src2] rows",
+        ),
+        (
+            ["programs", 0, "instructions"],
+            [[1.5, 2, 3, 4]],
+            "program 0 instructions must hold integers, got float64 values",
+        ),
+        (["programs", 0, "instructions"], [[99, 0, 1, 2]], "program 0: op out of range [0, 16)"),
+        (
+            ["next_team_id"],
+            2**63,
+            "population.next_team_id must fit a 64-bit integer, got 9223372036854775808",
+        ),
+        (
+            ["teams", 0, "birth"],
+            -(2**63) - 1,
+            "team 0 birth must fit a 64-bit integer, got -9223372036854775809",
+        ),
+        (["version"], 9, "population: unsupported version 9 (this mtpg reads 1 or 2)"),
+        (["version"], None, "population is missing key 'version'"),
+        (["format"], None, "population is missing key 'format'"),
+    ],
+)
+def test_layout_instruction_and_integer_errors(path, value, message) -> None:
+    with pytest.raises(FormatError) as err:
+        population_from_dict(changed(P, path, value, delete=value is None))
+    assert str(err.value) == message
+
+
+@pytest.mark.parametrize(
+    ("path", "value"),
+    [
+        (["layout", "n_memory"], 256),  # the largest bank
+        (["next_team_id"], 2**63 - 1),
+        (["teams", 0, "birth"], -(2**63)),
+    ],
+)
+def test_values_at_the_limits_are_accepted(path, value) -> None:
+    data = changed(P, path, value)
+    if path[0] == "layout":  # instructions must still fit: shift the memory target
+        data["programs"][0]["instructions"] = [[0, 0, 1, 2]]
+        data["programs"][1]["instructions"] = [[0, 0, 1, 2]]
+        data["programs"][2]["instructions"] = [[0, 0, 1, 2]]
+    population_from_dict(data)
+
+
+@pytest.mark.parametrize(
+    ("action", "message"),
+    [
+        (3, "program 2 action must be a JSON object, got int"),
+        ({"x": 1}, 'program 2 action must be {"atomic": a} or {"team": id}, got {\'x\': 1}'),
+        ({"atomic": -1}, "program 2 atomic action must be >= 0, got -1"),
+        ({"atomic": 3}, "program 2 atomic action must be < 3, got 3"),
+        ({"team": -1}, "program 2 team pointer must be >= 0, got -1"),
+        ({"team": 0}, None),  # team 0 is in the file
+    ],
+)
+def test_graph_action_pointers(action, message) -> None:
+    data = changed(G, ["programs", 0, "action"], action)
+    if message is None:
+        pop, _ = graph_from_dict(data)
+        assert pop.programs[2].action == 0
+        return
+    with pytest.raises(FormatError) as err:
+        graph_from_dict(data)
+    assert str(err.value) == message
+
+
+def test_graph_version() -> None:
+    with pytest.raises(FormatError) as err:
+        graph_from_dict(changed(G, ["version"], 2))
+    assert str(err.value) == "graph: unsupported version 2 (this mtpg reads 1)"

@@ -125,3 +125,19 @@ def test_checkpoint_generation_reads_only_checkpoint_names() -> None:
         "gen-000012.json.gz.tmp",
     ):
         assert checkpoint_generation(name) is None
+
+
+def test_lock_file_mode_unnamed_holder_and_undecodable_text(tmp_path) -> None:
+    umask = os.umask(0)
+    os.umask(umask)
+    with lock_dir(tmp_path):  # taken, not claimed: the holder is not known
+        assert (tmp_path / LOCK_FILE).stat().st_mode & 0o777 == 0o644 & ~umask
+        with pytest.raises(LockedError) as err:
+            lock_dir(tmp_path, "the run directory")
+    assert str(err.value).startswith(
+        f"{tmp_path}: the run directory is in use by another process ("
+    )
+    (tmp_path / LOCK_FILE).write_bytes(b"\xff\xfe 12 host\n")
+    assert holder(tmp_path) == ""  # undecodable bytes are replaced, never an error
+    (tmp_path / LOCK_FILE).write_bytes(b"12 h\xffst\n")
+    assert holder(tmp_path) == "process 12 on h\ufffdst"

@@ -247,3 +247,35 @@ def test_graph_version() -> None:
     with pytest.raises(FormatError) as err:
         graph_from_dict(changed(G, ["version"], 2))
     assert str(err.value) == "graph: unsupported version 2 (this mtpg reads 1)"
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "message"),
+    [
+        (["teams", 0, "programs"], 5, "team 0 programs must be a list, got int"),
+        (["banks"], 5, "population.banks must be a list, got int"),
+        (["teams", 0, "programs"], [0, 7], "population: team 0 holds missing program 7"),
+    ],
+)
+def test_id_lists_and_population_invariants(path, value, message) -> None:
+    with pytest.raises(FormatError) as err:
+        population_from_dict(changed(P, path, value))
+    assert str(err.value) == message
+
+
+def test_version_1_population_takes_its_banks_from_its_programs() -> None:
+    old = changed(P, ["version"], 1)
+    del old["banks"]
+    assert population_from_dict(old).memory_banks == {0, 1, 2}
+
+
+def test_graph_instructions_and_graph_to_dict_arguments() -> None:
+    with pytest.raises(FormatError) as err:
+        graph_from_dict(changed(G, ["programs", 0, "instructions"], 5))
+    assert str(err.value) == "program 2 instructions must be a list, got int"
+    with pytest.raises(ValueError) as err:
+        graph_to_dict(POP, ROOT, [1])
+    assert str(err.value) == "meta must be a dict, got list"
+    with pytest.raises(ValueError) as err:
+        graph_to_dict(POP, 99)
+    assert str(err.value) == "root team 99 is not in the population"

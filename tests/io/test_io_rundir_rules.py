@@ -87,8 +87,10 @@ def test_a_new_run_refuses_a_foreign_directory_naming_five_entries(tmp_path) -> 
         f"{tmp_path}: directory is not empty and is not an mtpg run directory "
         "(contains f0, f1, f2, f3, f4, ...); choose a new or empty directory"
     )
-    (tmp_path / "f5").unlink()
     (tmp_path / "f6").unlink()
+    with pytest.raises(RunDirError, match=r"\(contains f0, f1, f2, f3, f4, \.\.\.\); choose"):
+        check_new_run_dir(tmp_path)  # six: five shown
+    (tmp_path / "f5").unlink()
     with pytest.raises(RunDirError, match=r"\(contains f0, f1, f2, f3, f4\); choose"):
         check_new_run_dir(tmp_path)
 
@@ -137,8 +139,9 @@ def test_creation_rules_and_their_messages(tmp_path, monkeypatch) -> None:
     seen = []
     monkeypatch.setattr(rundir_module, "point", lambda phase, gen: seen.append((phase, gen)))
     run = init_run_dir(tmp_path / "run", "seed = 1\n")
-    init_run_dir(run.path, None, resume=True)
     assert seen == [("create", 0), ("created", 0)]
+    init_run_dir(run.path, None, resume=True)
+    assert seen == [("create", 0), ("created", 0)]  # resuming creates nothing
 
 
 def test_metrics_header_must_be_non_empty_without_repeats(tmp_path) -> None:
@@ -151,3 +154,36 @@ def test_metrics_header_must_be_non_empty_without_repeats(tmp_path) -> None:
     writer.close()
     raw = (tmp_path / "m.csv").read_bytes()
     assert raw == b'generation,x\n1,"a,b"\n'  # plain newlines, quoted commas
+
+
+def test_readable_json_nesting_levels() -> None:
+    assert dumps_readable({"a": {"b": 1}}) == '{\n  "a": {"b": 1}\n}\n'
+    assert dumps_readable({"a": {"b": [{"x": 1}]}}) == (
+        '{\n  "a": {\n    "b": [\n      {"x": 1}\n    ]\n  }\n}\n'
+    )
+    long = {"k": "y" * 80}
+    assert dumps_readable([[long]]) == (
+        f'[\n  [\n    {{\n      "k": "{"y" * 80}"\n    }}\n  ]\n]\n'
+    )
+
+
+def test_files_in_checkpoints_that_are_not_checkpoints_do_not_count(tmp_path) -> None:
+    run = init_run_dir(tmp_path / "run", "seed = 1\n")
+    (run.checkpoints / "notes.txt").write_text("")
+    (run.checkpoints / ".gen-000001.json.gz.x.tmp").write_text("")
+    assert check_new_run_dir(run.path) is True  # nothing committed: leftovers
+    (run.checkpoints / "gen-000001.json.gz").write_text("")
+    with pytest.raises(RunDirError, match="already holds an mtpg run"):
+        check_new_run_dir(run.path)
+
+
+def test_atomic_writes_go_through_a_temporary_file_beside_the_target(tmp_path) -> None:
+    from mtpg.io.checkpoint import save_checkpoint
+
+    path = tmp_path / "gen-000001.json.gz"
+    seen = []
+    save_checkpoint(path, {"a": 1}, lambda: seen.append(sorted(p.name for p in tmp_path.iterdir())))
+    (names,) = seen
+    assert len(names) == 1 and is_temp_file(names[0])
+    assert names[0].startswith(".gen-000001.json.gz.")
+    assert [p.name for p in tmp_path.iterdir()] == ["gen-000001.json.gz"]

@@ -281,3 +281,114 @@ def test_subset_count_and_elites_per_subset_rounding() -> None:
         for total in (0, 1, 50, 64, 100, 1575):
             c = merge(cfg, {"team": {"n_elite": 1, "min_elite_total": total}})
             assert c.elites_per_subset == max(1, math.ceil(total / (2**n - 1)))
+
+
+# --- hard limits, cross-field rules and file reading, each with its exact message ---------
+
+
+@pytest.mark.parametrize(
+    ("make", "key"),
+    [
+        (lambda v: ProgramConfig(max_length=v), "program.max_length"),
+        (lambda v: TeamConfig(max_team_size=v), "team.max_team_size"),
+        (lambda v: TeamConfig(min_elite_total=v), "team.min_elite_total"),
+        (lambda v: RunConfig(seed=v), "seed"),
+        (lambda v: RunConfig(workers=v), "workers"),
+    ],
+)
+def test_hard_limits_accept_the_limit_and_refuse_one_more(make, key) -> None:
+    from mtpg.limits import LIMITS
+
+    limit = LIMITS[key]
+    make(limit)  # the limit itself is allowed
+    with pytest.raises(ConfigError) as err:
+        make(limit + 1)
+    assert str(err.value) == f"{key} must be <= {limit:,} (hard limit), got {limit + 1}"
+
+
+def test_team_size_bound_against_initial_teams() -> None:
+    assert TeamConfig(init_team_size=5, max_team_size=5).max_team_size == 5
+    with pytest.raises(ConfigError) as err:
+        TeamConfig(init_team_size=5, max_team_size=4)
+    assert str(err.value) == "team.max_team_size must be >= team.init_team_size, got 4"
+
+
+def test_backend_and_dask_workers_are_validated() -> None:
+    assert RunConfig(backend="dask").backend == "dask"
+    assert RunConfig(backend="local", dask_workers=0).dask_workers == 0
+    with pytest.raises(ConfigError) as err:
+        RunConfig(backend="slurm")
+    assert str(err.value) == "backend must be local or dask, got 'slurm'"
+    with pytest.raises(ConfigError) as err:
+        RunConfig(dask_workers=-1)
+    assert str(err.value) == "dask_workers must be >= 0, got -1"
+
+
+@pytest.mark.parametrize("text", ["=1", "team..p_add=1", "team.=1", ".seed=1", "a b..c=1"])
+def test_overrides_with_an_empty_key_part_are_refused(text: str) -> None:
+    with pytest.raises(ConfigError) as err:
+        parse_override(text)
+    assert str(err.value) == f"override {text!r} must look like section.field=value"
+
+
+def test_override_nested_too_deeply_is_one_message() -> None:
+    text = "evaluation.tasks=" + "[" * 5000 + "]" * 5000
+    with pytest.raises(ConfigError) as err:
+        parse_override(text)
+    assert str(err.value) == f"override {text!r}: value is nested too deeply"
+
+
+def _read_error(path) -> str:
+    from mtpg.config import read_toml
+
+    with pytest.raises(ConfigError) as err:
+        read_toml(path)
+    return str(err.value)
+
+
+def test_unreadable_settings_files_are_one_message_naming_the_file(tmp_path) -> None:
+    assert _read_error(tmp_path) == f"{tmp_path}: is a directory, not a TOML file"
+    missing = tmp_path / "missing.toml"
+    assert _read_error(missing) == f"{missing}: no such file"
+    afile = tmp_path / "afile"
+    afile.write_text("seed = 1\n")
+    inside = afile / "x.toml"  # a path through a file: an OSError other than "not found"
+    assert _read_error(inside) == f"{inside}: cannot read: Not a directory"
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(b"seed = 1\n\xff\n")
+    assert _read_error(binary) == f"{binary}: not UTF-8 text (invalid start byte at byte 9)"
+    deep = tmp_path / "deep.toml"
+    deep.write_text("v = " + "[" * 5000 + "]" * 5000 + "\n")
+    assert _read_error(deep) == f"{deep}: not valid TOML: nested too deeply"
+
+
+def test_settings_file_size_limit_is_exact(tmp_path) -> None:
+    from mtpg.config import MAX_TOML_BYTES, read_toml
+
+    tail = "seed = 17\n"
+    path = tmp_path / "big.toml"
+    path.write_text("#" + " " * (MAX_TOML_BYTES - len(tail) - 2) + "\n" + tail)
+    assert path.stat().st_size == MAX_TOML_BYTES
+    assert read_toml(path) == {"seed": 17}  # exactly the limit: read whole
+    path.write_text("#" + " " * (MAX_TOML_BYTES - len(tail) - 1) + "\n" + tail)
+    assert _read_error(path) == (f"{path}: larger than {MAX_TOML_BYTES} bytes; not a settings file")
+
+
+def test_settings_file_is_read_with_a_bounded_read(tmp_path, monkeypatch) -> None:
+    """An endless file (a device, a pipe) is refused after MAX_TOML_BYTES + 1 bytes."""
+    import mtpg.config as config_module
+
+    class Endless:
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def read(self, n=-1):
+            assert n is not None and n >= 0, "unbounded read of a settings file"
+            return b"#" * n
+
+    monkeypatch.setattr(config_module, "open", lambda *a, **k: Endless(), raising=False)
+    message = _read_error(tmp_path / "endless.toml")
+    assert message.endswith("bytes; not a settings file")

@@ -211,7 +211,7 @@ class Varier:
         action, bank = old.action, old.bank
         if rng.random() < self.cfg.p_action:
             last_atomic = action < 0 and sum(self._is_atomic(q) for q in progs) == 1
-            action = self._new_action(action, force_atomic=last_atomic)
+            action = self._new_action(force_atomic=last_atomic)
         if rng.random() < self.cfg.p_memory and len(self.banks) > 1:
             bank = self._other_bank(old.bank)
         return self.pop.add_program(code, action, bank).id
@@ -228,8 +228,11 @@ class Varier:
             return self.banks[i + (i >= k)]
         return self.banks[int(self.rng.integers(0, len(self.banks)))]
 
-    def _new_action(self, current: int, force_atomic: bool) -> int:
+    def _new_action(self, force_atomic: bool) -> int:
         """Draws a new action pointer: atomic with ``p_atomic``, else an older team.
+
+        The draw does not depend on the current pointer (which may be drawn again);
+        ``force_atomic`` keeps a team's last atomic program atomic.
 
         A root chosen as target is cloned first and the clone is pointed to ("clone when
         subsumed"), so the root stays an independent agent.

@@ -4,7 +4,7 @@ A fixed, seeded workload: ``graphs`` independent random graphs (``teams`` x ``pr
 x ``instructions``, about 40% of programs pointing to a later team, one memory bank per
 program) each play ``episodes`` CartPole episodes. Episode start states come from a fixed
 pool drawn by :func:`mtpg.envs.make_episodes`; graph ``g``'s ``k``-th episode is pool row
-``(g + k * graphs) % EPISODE_POOL`` (:func:`episode_row`).
+``(g + k * graphs) % EPISODE_POOL``.
 
 The workload is a batch of jobs (graph x episode) exactly as training builds one, and it
 is played by :func:`mtpg.engine.batch.run_jobs`, the call training makes: the benchmark
@@ -54,11 +54,6 @@ def pointer_probability(teams: int, programs: int, fraction: float = POINTER_FRA
     return min(1.0, fraction * teams * programs / eligible)
 
 
-def episode_row(graph: int, k: int, n_graphs: int, n_pool: int = EPISODE_POOL) -> int:
-    """Pool row of the ``k``-th episode of graph ``graph``."""
-    return (graph + k * n_graphs) % n_pool
-
-
 @dataclass(frozen=True)
 class Workload:
     """The benchmark's graphs and episodes, as one batch of jobs.
@@ -67,7 +62,6 @@ class Workload:
         pop: The population holding every graph.
         root_ids: Model id of each graph's root team.
         cp: The compiled population.
-        roots: int64 dense root team index of each graph.
         pool: The ``EPISODE_POOL`` CartPole episodes (start states and noise).
         job_roots: int64 ``[graphs * episodes]`` dense root of each job (graph-major).
         job_episodes: int64 ``[graphs * episodes]`` pool row of each job.
@@ -82,7 +76,6 @@ class Workload:
     pop: Population
     root_ids: list[int]
     cp: CompiledPopulation
-    roots: np.ndarray
     pool: Episodes
     job_roots: np.ndarray
     job_episodes: np.ndarray
@@ -97,10 +90,6 @@ class Workload:
     def n_graphs(self) -> int:
         """Number of graphs."""
         return len(self.root_ids)
-
-    def jobs_of(self, graph: int) -> slice:
-        """The jobs (episodes) of one graph, in order."""
-        return slice(graph * self.episodes, (graph + 1) * self.episodes)
 
 
 def make_workload(
@@ -143,7 +132,6 @@ def make_workload(
         pop=pop,
         root_ids=root_ids,
         cp=cp,
-        roots=roots,
         pool=pool,
         job_roots=roots[g],
         job_episodes=(g + k * graphs) % EPISODE_POOL,

@@ -1,7 +1,7 @@
 """Step-by-step outputs of the production decision kernel, for the parity tests.
 
 This driver is test support and lives with the tests: the package's one episode loop is
-:func:`mtpg.engine.kernels.run_jobs_strided` (training, testing and the benchmark), besides
+:func:`mtpg.engine.kernels.run_jobs_queue` (training, testing and the benchmark), besides
 the instrumented tracer of :mod:`mtpg.engine.trace` that the analyses use.
 
 Training and testing call :func:`mtpg.engine.kernels.decide` from the batch kernels, which
@@ -191,7 +191,7 @@ def step_episode(
     M,
     base,
 ):  # noqa: N803
-    """Plays one episode as ``run_jobs_strided`` does, recording every decision.
+    """Plays one episode as ``run_jobs_queue`` does, recording every decision.
 
     Returns:
         The outputs of :func:`step_sequence`, then ``observations (n, 2)`` (what each

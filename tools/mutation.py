@@ -402,6 +402,22 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
         "reward, terminated = mountaincar.step_continuous(p, state, a_c)",
         _ENGINE,
     ),
+    # the batch kernel's job queue (every block taken exactly once)
+    HandMutant(
+        "queue-fetch-add-not-atomic",
+        "src/mtpg/engine/kernels.py",
+        'return builder.atomic_rmw("add", ptr, one, "monotonic")',
+        "old = builder.load(ptr)\n        builder.store(builder.add(old, one), ptr)\n"
+        "        return old",
+        ("tests/engine/test_job_queue.py",),
+    ),
+    HandMutant(
+        "queue-skips-first-block",
+        "src/mtpg/engine/kernels.py",
+        "first = _fetch_add(next_block) * block",
+        "first = (_fetch_add(next_block) + 1) * block",
+        _ENGINE,
+    ),
     HandMutant(
         "kernel-continuous-output-register",
         "src/mtpg/engine/kernels.py",

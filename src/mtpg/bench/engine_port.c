@@ -1,6 +1,6 @@
 /* The engine benchmark's workload in hand-written C: the yardstick of `mtpg bench engine --c`.
  *
- * The same work as mtpg.engine.kernels.run_jobs_strided on one thread: every job (graph x
+ * The same work as mtpg.engine.kernels.run_jobs_queue on one thread: every job (graph x
  * CartPole episode) resets the task, then decides and steps until the episode ends; a
  * decision traverses the graph from the job's root, running each visited team's programs
  * on a workspace of private registers, constants, the observation and the memory banks,

@@ -8,12 +8,8 @@ import numba
 import numpy as np
 
 from mtpg.engine.compile import CompiledPopulation
-from mtpg.engine.kernels import run_jobs_parallel, run_jobs_strided
+from mtpg.engine.kernels import run_jobs_parallel, run_jobs_queue
 from mtpg.envs import TASK_PARAMS, make_episodes
-
-#: Chunks per thread in parallel runs: jobs are dealt out round-robin, so episodes of
-#: uneven length balance out across threads.
-CHUNKS_PER_THREAD = 8
 
 
 @dataclass(frozen=True)
@@ -87,9 +83,9 @@ def run_jobs(
         episodes: The episode table.
         threads: Numba threads to use (1: serial kernel, no thread pool).
         no_memory: Zero each bank before every program execution (ablation).
-        block: Jobs dealt out together to one chunk (see ``run_jobs_strided``); the
-            number of jobs per root keeps each root's episodes on one thread, in order.
-            Results do not depend on it.
+        block: Jobs taken together from the queue by one thread (see
+            ``run_jobs_queue``); the number of jobs per root keeps each root's episodes on
+            one thread, in order. Results do not depend on it.
 
     Returns:
         The per-job outcomes.
@@ -116,11 +112,13 @@ def run_jobs(
         out.instructions,
         *cp.kernel_args(),
     )
+    queue = np.zeros(1, dtype=np.int64)
     if threads == 1:
-        run_jobs_strided(0, 1, block, *args)
+        run_jobs_queue(queue, block, *args)
     else:
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-        run_jobs_parallel(threads * CHUNKS_PER_THREAD, block, *args)
+        threads = min(threads, numba.config.NUMBA_NUM_THREADS)
+        numba.set_num_threads(threads)
+        run_jobs_parallel(threads, queue, block, *args)
     return out
 
 

@@ -32,7 +32,7 @@ from mtpg.config import ConfigError
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.evaluator import BackendLost
-from mtpg.engine.kernels import run_jobs_strided
+from mtpg.engine.kernels import run_jobs_queue
 from mtpg.envs import TASK_PARAMS
 
 #: Batches per worker thread: enough to balance episodes of uneven cost, few enough that
@@ -75,7 +75,8 @@ def play_batch(
     """
     n = len(job_roots)
     out = (np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
-    run_jobs_strided(0, 1, 1, job_roots, job_eps, *table, TASK_PARAMS, no_memory, *out, *graph)
+    queue = np.zeros(1, dtype=np.int64)
+    run_jobs_queue(queue, 1, job_roots, job_eps, *table, TASK_PARAMS, no_memory, *out, *graph)
     return out
 
 

@@ -14,7 +14,9 @@ each episode. Visited teams are marked the same way with a per-decision stamp.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from mtpg.engine.ops import apply_op
 from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
@@ -32,6 +34,25 @@ from mtpg.envs.tasks import P_MAX_STEPS
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
 _CONSTANTS = CONSTANTS.copy()
+
+
+@intrinsic
+def _fetch_add(typingctx, counter):
+    """Atomically adds 1 to ``counter[0]`` (int64) and returns the value it had."""
+    if not (isinstance(counter, types.Array) and counter.dtype == types.int64):
+        return None
+
+    def codegen(context, builder, signature, args):
+        array = context.make_array(signature.args[0])(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(
+            context, builder, signature.args[0], array, [context.get_constant(types.intp, 0)]
+        )
+        one = context.get_constant(types.int64, 1)
+        # "monotonic": only the uniqueness of the values handed out matters; the outputs
+        # each block writes are joined by the end of the parallel region.
+        return builder.atomic_rmw("add", ptr, one, "monotonic")
+
+    return types.int64(counter), codegen
 
 
 @njit(cache=True, error_model="numpy")
@@ -158,9 +179,8 @@ def decide(
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_jobs_strided(
-    chunk,
-    n_chunks,
+def run_jobs_queue(
+    next_block,
     block,
     job_root,
     job_ep,
@@ -183,12 +203,19 @@ def run_jobs_strided(
     M,
     base,
 ):  # noqa: N803
-    """Runs chunk ``chunk`` of ``n_chunks`` serially with one private workspace.
+    """One worker: takes blocks of jobs from a shared queue and plays them serially.
 
-    Jobs are dealt out in blocks of ``block`` consecutive jobs: the chunk runs blocks
-    ``chunk, chunk + n_chunks, ...``. Consecutive jobs usually share a root (all its
-    episodes), so a block keeps one graph's code and memory banks in cache, while dealing
-    blocks round-robin balances long and short episodes across chunks.
+    Jobs go in blocks of ``block`` consecutive jobs; block ``b`` is jobs
+    ``b * block ... (b + 1) * block - 1``. The queue is the int64 counter ``next_block[0]``:
+    the worker takes the next block with an atomic fetch-and-add until none is left, so
+    workers sharing one counter (:func:`run_jobs_parallel`) balance long and short
+    episodes among themselves whatever their speed, and a worker with a counter of its own
+    plays every job in order. Consecutive jobs usually share a root (all its episodes), so a
+    block keeps one graph's code and memory banks in cache. The private workspace is
+    allocated once per worker, not per block.
+
+    Results do not depend on which worker plays a job: every job starts from a fresh
+    memory state (the lazy bank reset keyed by the job index).
 
     Releases the GIL, so several Python threads (e.g. of one Dask worker) run it at once.
 
@@ -200,7 +227,10 @@ def run_jobs_strided(
     obs = W[R + N_CONSTANTS : R + N_CONSTANTS + 2]
     stamp = 0
     n_jobs = len(job_root)
-    for first in range(chunk * block, n_jobs, n_chunks * block):
+    while True:
+        first = _fetch_add(next_block) * block
+        if first >= n_jobs:
+            break
         for j in range(first, min(first + block, n_jobs)):
             e = job_ep[j]
             task = ep_task[e]
@@ -262,7 +292,8 @@ def run_jobs_strided(
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def run_jobs_parallel(
-    n_chunks,
+    n_workers,
+    next_block,
     block,
     job_root,
     job_ep,
@@ -285,11 +316,15 @@ def run_jobs_parallel(
     M,
     base,
 ):  # noqa: N803
-    """Runs all jobs, ``n_chunks`` strided chunks spread over the Numba threads."""
-    for c in prange(n_chunks):
-        run_jobs_strided(
-            c,
-            n_chunks,
+    """Runs all jobs on ``n_workers`` workers (one per Numba thread) sharing one queue.
+
+    ``next_block`` is the queue's counter (int64 ``[1]``, 0 to start); once every job is
+    played it holds the number of blocks plus ``n_workers`` (each worker's last take finds
+    the queue empty).
+    """
+    for _ in prange(n_workers):
+        run_jobs_queue(
+            next_block,
             block,
             job_root,
             job_ep,

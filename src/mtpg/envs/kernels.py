@@ -98,7 +98,7 @@ def env_step(
         (reward, terminated, truncated); truncated is True when the step count reaches the
         task's time limit without termination.
 
-    The batch kernel (:func:`mtpg.engine.kernels.run_jobs_strided`) repeats this dispatch
+    The batch kernel (:func:`mtpg.engine.kernels.run_jobs_queue`) repeats this dispatch
     in its episode loop, for speed; the two must stay the same (the engine's parity tests
     play every task through both).
     """

@@ -39,6 +39,25 @@ def test_bench_engine_prints_json_last(capsys):
     assert result["instructions_per_decision"] > 0
 
 
+def test_bench_engine_on_two_threads_reports_interleaved_scaling(capsys):
+    """Above one thread every timed run is paired with a one-thread run (same results)."""
+    argv = ["bench", "engine", "--graphs", "30", "--episodes", "2", "--repeats", "3"]
+    assert main([*argv, "--threads", "2", "--reference-graphs", "0", "--no-pytpg"]) == 0
+    out = capsys.readouterr().out
+    assert "interleaved pairs" in out
+    result = json.loads(out.strip().splitlines()[-1])
+    assert result["threads"] == 2
+    assert len(result["scaling_all"]) == 3 and result["scaling"] > 0
+    assert result["one_thread_decisions_per_s"] > 0
+
+
+def test_bench_engine_one_thread_has_no_scaling(capsys):
+    argv = ["bench", "engine", "--graphs", "5", "--episodes", "2", "--repeats", "1"]
+    assert main([*argv, "--reference-graphs", "0", "--no-pytpg"]) == 0
+    result = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert result["scaling"] is None and "scaling_all" not in result
+
+
 def test_bench_engine_rejects_bad_threads(capsys):
     code = main(["bench", "engine", "--graphs", "2", "--episodes", "5", "--threads", "0"])
     assert code == 2

@@ -216,6 +216,18 @@ def machine_info() -> dict:
     }
 
 
+def _same_result(a: BatchResult, b: BatchResult) -> bool:
+    """Whether two runs of the workload gave the same outcome for every job."""
+    return all(
+        np.array_equal(x, y)
+        for x, y in zip(
+            (a.returns, a.steps, a.teams, a.instructions),
+            (b.returns, b.steps, b.teams, b.instructions),
+            strict=True,
+        )
+    )
+
+
 def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, flags):
     """Times the C port interleaved with the engine: C, engine, C, engine, ...
 
@@ -266,8 +278,11 @@ def benchmark(
         programs: Programs per team.
         instructions: Instructions per program.
         episodes: CartPole episodes per graph.
-        threads: Numba threads of the compiled runs.
-        repeats: Timed compiled runs; the median is reported.
+        threads: Numba threads of the compiled runs. Above 1, every timed run is paired
+            with a one-thread run just before it, and the scaling reported is the median
+            over pairs of the one-thread time over the N-thread time (interleaving cancels
+            the drift of a shared machine's speed).
+        repeats: Timed compiled runs (pairs above 1 thread); the median is reported.
         seed: Workload seed.
         reference_graphs: Graphs played by the reference interpreter and by pytpg.
         pytpg: Time pytpg too (when installed).
@@ -289,15 +304,20 @@ def benchmark(
     warm_up(threads)
     say(f"building {graphs} graphs ...")
     work = make_workload(graphs, teams, programs, instructions, episodes, seed)
-    runs = []
+    runs, singles = [], []
     for r in range(repeats):
+        if threads > 1:  # the scaling: one-thread runs interleaved with the N-thread runs
+            singles.append(drive(work, 1))
         res = drive(work, threads)
         runs.append(res)
-        say(f"  run {r + 1}/{repeats}: {res.decisions / res.seconds:,.0f} decisions/s")
+        say(
+            f"  run {r + 1}/{repeats}: {res.decisions / res.seconds:,.0f} decisions/s"
+            + (f" (1 thread: {res.decisions / singles[-1].seconds:,.0f})" if singles else "")
+        )
     first = runs[0].result
-    for res in runs[1:]:
-        if not np.array_equal(res.result.instructions, first.instructions):
-            raise RuntimeError("compiled runs disagree between repeats")
+    for res in runs[1:] + singles:
+        if not _same_result(res.result, first):
+            raise RuntimeError("compiled runs disagree between repeats or thread counts")
     seconds = statistics.median(r.seconds for r in runs)
     decisions = runs[0].decisions
     record = min(reference_graphs, graphs)
@@ -338,6 +358,8 @@ def benchmark(
         "speedup_vs_reference": rate / ref_rate if ref_rate else None,
         "speedup_vs_pytpg": rate / pt_rate if pt_rate else None,
         "pytpg_teams_per_decision": pt["teams"] / pt["decisions"] if pt else None,
+        "one_thread_decisions_per_s": None,
+        "scaling": None,
         "c_decisions_per_s": None,
         "engine_cpu_decisions_per_s": None,
         "engine_vs_c": None,
@@ -357,6 +379,13 @@ def benchmark(
         "seed": seed,
         "machine": machine_info(),
     }
+    if singles:
+        scaling = [a.seconds / b.seconds for a, b in zip(singles, runs, strict=True)]
+        out["one_thread_decisions_per_s"] = decisions / statistics.median(
+            a.seconds for a in singles
+        )
+        out["scaling"] = statistics.median(scaling)
+        out["scaling_all"] = scaling
     if c_pairs is not None:
         c_cpu, e_cpu = c_pairs
         ratios = [cc / ee for cc, ee in zip(c_cpu, e_cpu, strict=True)]

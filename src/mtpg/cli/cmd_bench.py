@@ -33,7 +33,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     eng.add_argument("--programs", type=int, default=10, help="programs per team (10)")
     eng.add_argument("--instructions", type=int, default=10, help="instructions per program (10)")
     eng.add_argument("--episodes", type=int, default=16, help="CartPole episodes per graph (16)")
-    eng.add_argument("--threads", type=int, default=1, help="Numba threads (1)")
+    eng.add_argument(
+        "--threads",
+        type=int,
+        default=1,
+        help="Numba threads (1); above 1, each run is paired with a one-thread run for the scaling",
+    )
     eng.add_argument("--repeats", type=int, default=3, help="timed runs, median reported (3)")
     eng.add_argument("--seed", type=int, default=0, help="workload seed (0)")
     eng.add_argument(
@@ -125,6 +130,13 @@ def run(args: argparse.Namespace) -> int:
         ),
         f"  setup         {r['build_seconds']:.1f} s to draw and compile the graphs",
     ]
+    if r["scaling"] is not None:
+        lines.insert(
+            4,
+            f"  scaling       {r['scaling']:.2f}x one thread on {r['threads']} threads (one"
+            f" thread {_fmt(r['one_thread_decisions_per_s'])} decisions/s; median of"
+            f" {r['repeats']} interleaved pairs, wall time)",
+        )
     if r["engine_vs_c"] is not None:
         lines.insert(
             -1,

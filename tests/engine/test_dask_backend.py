@@ -50,9 +50,9 @@ def run(config, evaluator=None):
     return rows, tests, trainer.state.champions
 
 
-def test_plan_batches_about_four_per_thread_with_enough_roots_each():
+def test_plan_batches_about_eight_per_thread_with_enough_roots_each():
     assert plan_batches(6000, 30, threads=8, min_roots=10) == 20  # 200 roots: 20 of 10
-    assert plan_batches(60000, 30, threads=8, min_roots=10) == 32  # 4 per thread
+    assert plan_batches(60000, 30, threads=8, min_roots=10) == 64  # 8 per thread
     assert plan_batches(30, 30, threads=8, min_roots=10) == 1
     assert plan_batches(5, 1, threads=2, min_roots=1) == 5
 

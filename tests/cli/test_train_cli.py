@@ -166,3 +166,41 @@ def test_test_points_follow_the_interval(tmp_path):
     assert score == meta["test"]["CartPole"]
     row = next(r for r in rows if r["generation"] == "4" and r["subset"] == "CartPole")
     assert float(row["test_CartPole"]) == score
+
+
+def test_a_lost_backend_commits_the_generation_and_resume_finishes_the_run(
+    tmp_path, capsys, monkeypatch
+):
+    """A backend lost during generation 2 stops ``mtpg train`` right after it, committed."""
+    import mtpg.evolve.trainer as trainer_module
+    from mtpg.engine.evaluator import BackendLost, LocalEvaluator
+
+    reference = tmp_path / "reference"
+    assert main(["train", *TINY, "--generations", "4", "--out", str(reference)]) == 0
+
+    class LosesItsCluster(LocalEvaluator):
+        evaluations = 0
+
+        def evaluate(self, *args, **kwargs):
+            LosesItsCluster.evaluations += 1
+            return super().evaluate(*args, **kwargs)
+
+        def check(self):
+            if LosesItsCluster.evaluations >= 2:  # lost while generation 2 was evaluated
+                raise BackendLost("lost the dask cluster at tcp://127.0.0.1:1 (gone)")
+
+    monkeypatch.setattr(trainer_module, "make_evaluator", lambda cfg: LosesItsCluster(1))
+    out = tmp_path / "run"
+    capsys.readouterr()
+    assert main(["train", *TINY, "--generations", "4", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "lost the evaluation backend (lost the dask cluster at tcp://127.0.0.1:1" in err
+    assert f"after generation 2 (committed); resume with: mtpg train --resume {out}" in err
+    assert "Traceback" not in err
+    assert (out / "checkpoints" / "gen-000002.json.gz").is_file()
+    assert len(metrics(out)) == 2
+    monkeypatch.undo()
+    assert main(["train", "--resume", str(out), "--quiet"]) == 0
+    assert metrics(out) == metrics(reference)
+    champions = {p.name: p.read_bytes() for p in (out / "champions").iterdir()}
+    assert champions == {p.name: p.read_bytes() for p in (reference / "champions").iterdir()}

@@ -114,16 +114,6 @@ def run(args: argparse.Namespace) -> int:
 
     lost: list[BackendLost] = []
 
-    def should_stop() -> bool:  # a signal, or a lost cluster: stop at this boundary
-        if stop.requested():
-            return True
-        try:
-            session.trainer.evaluator.check()
-        except BackendLost as exc:
-            lost.append(exc)
-            return True
-        return False
-
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
             config = merge_overrides(read_run_config(args.resume), overrides(args))
@@ -140,7 +130,12 @@ def run(args: argparse.Namespace) -> int:
         )
         progress = None if args.quiet else Progress.for_session(session)
         try:
-            finished = session.run_all(progress, should_stop)
+            # a signal stops at the next boundary; so does a lost cluster (run_all raises
+            # BackendLost once the last generation is committed)
+            finished = session.run_all(progress, stop.requested)
+        except BackendLost as exc:
+            lost.append(exc)
+            finished = False
         except StopNow as exc:
             if progress:
                 progress.close()

@@ -23,6 +23,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from mtpg.config import ConfigError, RunConfig, to_toml
+from mtpg.engine.evaluator import BackendLost
 from mtpg.evolve.persist import (
     RESUMABLE_CHANGES,
     config_differences,
@@ -186,6 +187,11 @@ class Session:
     ) -> bool:
         """Runs the remaining generations, then releases the directory.
 
+        A lost evaluation backend (a Dask cluster whose scheduler went away) stops the run
+        the same way, at the boundary after the generation it was lost in: that
+        generation is committed, then :class:`~mtpg.engine.evaluator.BackendLost` is
+        raised, and ``resume`` continues the run from there.
+
         Args:
             on_generation: Called with each metrics row and the trainer (e.g. progress).
             should_stop: Asked before each generation; True ends the run there, after
@@ -193,14 +199,32 @@ class Session:
 
         Returns:
             True when every configured generation has run, False when stopped early.
+
+        Raises:
+            BackendLost: The backend was lost; the last generation is committed.
         """
         reporters = [self.metrics, self.tests, self.checkpoints]
         if on_generation is not None:
             reporters.append(CallbackReporter(on_generation))
+        lost: list[BackendLost] = []
+
+        def stop_here() -> bool:
+            if should_stop is not None and should_stop():
+                return True
+            try:
+                self.trainer.evaluator.check()
+            except BackendLost as exc:
+                lost.append(exc)
+                return True
+            return False
+
         try:
-            return train(self.trainer, reporters, should_stop)
+            finished = train(self.trainer, reporters, stop_here)
         finally:
             self.close()
+        if lost:
+            raise lost[0]
+        return finished
 
     def checkpoint(self) -> Path:
         """Commits the current generation now (champions, then the checkpoint)."""

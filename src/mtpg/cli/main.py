@@ -132,6 +132,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return EXIT_USAGE
     debug = args.debug or bool(os.environ.get("MTPG_DEBUG"))
+    set_here = debug and not os.environ.get("MTPG_DEBUG")
+    if set_here:  # libraries' own logs too (Dask's, see DaskEvaluator), and child processes
+        os.environ["MTPG_DEBUG"] = "1"
     try:
         code = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at exit
@@ -157,6 +160,9 @@ def main(argv: list[str] | None = None) -> int:
         except BrokenPipeError:
             pass
         return code
+    finally:
+        if set_here:
+            del os.environ["MTPG_DEBUG"]
 
 
 if __name__ == "__main__":

@@ -93,6 +93,13 @@ def warm_up() -> int:
     return os.getpid()
 
 
+def _set_dask_log_level(level: int) -> None:
+    """Sets the level of Dask's loggers (some, like the client's, have their own)."""
+    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
+    for name in ["distributed", *names]:
+        logging.getLogger(name).setLevel(level)
+
+
 def plan_batches(n_jobs: int, jobs_per_root: int, threads: int, min_roots: int) -> int:
     """Number of batches for ``n_jobs`` jobs on a cluster with ``threads`` worker threads.
 
@@ -117,6 +124,13 @@ class DaskEvaluator:
         min_roots: Fewest roots per batch.
         timeout: Seconds to wait for the scheduler (to connect, and to reconnect before it
             counts as lost); :data:`CONNECT_TIMEOUT` when None.
+
+    Dask's own log messages in this process (the client's and, for a local cluster, the
+    scheduler's and nannies') are silenced: a lost scheduler would otherwise print
+    Dask's tracebacks of every reconnection attempt, while the run reports what matters
+    in one line of its own (errors are one line unless asked for). With the environment
+    variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as Dask logs
+    them.
     """
 
     def __init__(
@@ -129,6 +143,8 @@ class DaskEvaluator:
     ) -> None:
         from distributed import Client, LocalCluster
 
+        log_level = logging.INFO if os.environ.get("MTPG_DEBUG") else logging.CRITICAL
+        _set_dask_log_level(log_level)
         timeout = CONNECT_TIMEOUT if timeout is None else timeout
         self.address = address
         self.fallback_threads = fallback_threads
@@ -157,7 +173,7 @@ class DaskEvaluator:
                     processes=True,
                     host="127.0.0.1",
                     dashboard_address=None,
-                    silence_logs=logging.ERROR,
+                    silence_logs=max(log_level, logging.ERROR),
                 )
             self.client = Client(self.cluster, timeout=timeout)
             self.address = self.cluster.scheduler_address

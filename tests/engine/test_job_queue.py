@@ -89,17 +89,22 @@ def test_python_threads_racing_on_one_counter_lose_no_update():
 
 
 @numba.njit(parallel=True)
-def _hammer(counter, taken):
-    for i in numba.prange(len(taken)):
+def _hammer(counter, n, sink):
+    for i in numba.prange(n):
         # the store may alias the counter, so every take reloads it (no hoisting)
-        taken[i] = _fetch_add(counter)
+        sink[i & 1023] = _fetch_add(counter)
 
 
 def test_fetch_add_is_atomic_under_contention():
-    """Two threads taking in a tight loop: a plain load-add-store would lose updates."""
+    """Two threads taking in a tight loop: a plain load-add-store would lose updates.
+
+    (Lost updates need the two threads to run at the same moment; on a machine busy with
+    other work they rarely do, so the count is large.)
+    """
     numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
     counter = np.zeros(1, dtype=np.int64)
-    taken = np.full(2_000_000, -1, dtype=np.int64)
-    _hammer(counter, taken)
-    assert counter[0] == len(taken)
-    assert np.array_equal(np.sort(taken), np.arange(len(taken)))
+    n = 20_000_000
+    sink = np.zeros(1024, dtype=np.int64)
+    _hammer(counter, n, sink)
+    assert counter[0] == n
+    assert sink.max() < n

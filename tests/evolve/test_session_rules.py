@@ -154,20 +154,10 @@ def test_run_all_asks_should_stop_before_each_generation(tmp_path) -> None:
 def test_a_lost_backend_commits_the_generation_it_was_lost_in(tmp_path, monkeypatch):
     """``run_all`` commits the last generation, then raises, even between checkpoints."""
     import mtpg.evolve.trainer as trainer_module
-    from mtpg.engine.evaluator import BackendLost, LocalEvaluator
+    from mtpg.engine.evaluator import BackendLost
+    from standins import losing_backend
 
-    class Lost(LocalEvaluator):
-        evaluations = 0
-
-        def evaluate(self, *args, **kwargs):
-            Lost.evaluations += 1
-            return super().evaluate(*args, **kwargs)
-
-        def check(self):
-            if Lost.evaluations >= 2:
-                raise BackendLost("gone")
-
-    monkeypatch.setattr(trainer_module, "make_evaluator", lambda cfg: Lost(1))
+    monkeypatch.setattr(trainer_module, "make_evaluator", lambda cfg: losing_backend(2)(1))
     run = tmp_path / "run"
     session = Session(run, tiny("checkpoint_interval=10", "generations=4"))
     with pytest.raises(BackendLost, match="gone"):

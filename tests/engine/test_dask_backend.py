@@ -51,10 +51,10 @@ def run(config, evaluator=None):
 
 
 def test_plan_batches_about_eight_per_thread_with_enough_roots_each():
-    assert plan_batches(6000, 30, threads=8, min_roots=10) == 20  # 200 roots: 20 of 10
-    assert plan_batches(60000, 30, threads=8, min_roots=10) == 64  # 8 per thread
-    assert plan_batches(30, 30, threads=8, min_roots=10) == 1
-    assert plan_batches(5, 1, threads=2, min_roots=1) == 5
+    assert plan_batches(200, threads=8, min_roots=10) == 20  # 200 roots: 20 of 10
+    assert plan_batches(2000, threads=8, min_roots=10) == 64  # 8 per thread
+    assert plan_batches(1, threads=8, min_roots=10) == 1
+    assert plan_batches(5, threads=2, min_roots=1) == 5
 
 
 @pytest.mark.parametrize("no_memory", [False, True])
@@ -236,3 +236,18 @@ def test_a_lost_scheduler_stops_the_run_at_a_boundary_and_resume_continues_it(
         second.stop()
     assert metrics(tmp_path / "dask") == metrics(tmp_path / "local")
     assert champions(tmp_path / "dask") == champions(tmp_path / "local")
+
+
+def test_dask_logs_are_silenced_while_open_and_restored_on_close(monkeypatch):
+    import logging
+
+    monkeypatch.delenv("MTPG_DEBUG", raising=False)
+    client_log = logging.getLogger("distributed.client")
+    before = client_log.level
+    ev = DaskEvaluator(n_workers=1)
+    try:
+        assert client_log.level == logging.CRITICAL
+        assert logging.getLogger("distributed").level == logging.CRITICAL
+    finally:
+        ev.close()
+    assert client_log.level == before

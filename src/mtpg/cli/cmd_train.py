@@ -112,7 +112,7 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.evolve.session import Session, read_run_config
     from mtpg.evolve.stopping import GracefulStop, StopNow, exit_code
 
-    lost: list[BackendLost] = []
+    lost: BackendLost | None = None
 
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
@@ -134,8 +134,7 @@ def run(args: argparse.Namespace) -> int:
             # BackendLost once the last generation is committed)
             finished = session.run_all(progress, stop.requested)
         except BackendLost as exc:
-            lost.append(exc)
-            finished = False
+            lost, finished = exc, False
         except StopNow as exc:
             if progress:
                 progress.close()
@@ -148,15 +147,17 @@ def run(args: argparse.Namespace) -> int:
             return exit_code(exc.signum)
         finally:
             session.trainer.close()  # stops a local Dask cluster started for the run
-    if not finished and (lost or stop.signum is not None):
+    if not finished and (lost is not None or stop.signum is not None):
         if progress:
             progress.close()
-        why = f"lost the evaluation backend ({lost[0]})" if lost else f"stopped by {stop.name}"
+        why = f"stopped by {stop.name}"
+        if lost is not None:
+            why = f"lost the evaluation backend ({lost})"
         print(
             f"{why} after generation {session.saved_generation} (committed); "
             f"resume with: mtpg train --resume {where}",
             file=sys.stderr,
         )
-        return 1 if lost else exit_code(stop.signum)
+        return 1 if lost is not None else exit_code(stop.signum)
     print(f"done: {where}", file=sys.stderr)
     return 0

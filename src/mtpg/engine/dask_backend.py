@@ -93,22 +93,34 @@ def warm_up() -> int:
     return os.getpid()
 
 
-def _set_dask_log_level(level: int) -> None:
-    """Sets the level of Dask's loggers (some, like the client's, have their own)."""
+def _set_dask_log_level(level: int) -> dict[str, int]:
+    """Sets the level of Dask's loggers (some, like the client's, have their own).
+
+    Returns:
+        The levels they had, by logger name (to put back with :func:`_restore_log_levels`).
+    """
     names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] == "distributed"]
-    for name in ["distributed", *names]:
+    old = {}
+    for name in dict.fromkeys(["distributed", *names]):
+        logger = logging.getLogger(name)
+        old[name] = logger.level
+        logger.setLevel(level)
+    return old
+
+
+def _restore_log_levels(levels: dict[str, int]) -> None:
+    for name, level in levels.items():
         logging.getLogger(name).setLevel(level)
 
 
-def plan_batches(n_jobs: int, jobs_per_root: int, threads: int, min_roots: int) -> int:
-    """Number of batches for ``n_jobs`` jobs on a cluster with ``threads`` worker threads.
+def plan_batches(n_roots: int, threads: int, min_roots: int) -> int:
+    """Number of batches for ``n_roots`` roots on a cluster with ``threads`` worker threads.
 
     About :data:`TASKS_PER_THREAD` batches per thread, but each with at least
-    ``min_roots`` roots' worth of jobs, and at least one batch. Batches hold whole roots,
-    so there are never more batches than roots.
+    ``min_roots`` roots (a batch holds whole roots), and at least one batch.
     """
-    most = max(1, n_jobs // max(1, jobs_per_root * min_roots))
-    return max(1, min(TASKS_PER_THREAD * max(1, threads), most, n_jobs))
+    most = max(1, n_roots // max(1, min_roots))
+    return max(1, min(TASKS_PER_THREAD * max(1, threads), most))
 
 
 class DaskEvaluator:
@@ -126,11 +138,11 @@ class DaskEvaluator:
             counts as lost); :data:`CONNECT_TIMEOUT` when None.
 
     Dask's own log messages in this process (the client's and, for a local cluster, the
-    scheduler's and nannies') are silenced: a lost scheduler would otherwise print
-    Dask's tracebacks of every reconnection attempt, while the run reports what matters
-    in one line of its own (errors are one line unless asked for). With the environment
-    variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as Dask logs
-    them.
+    scheduler's and nannies') are silenced until :meth:`close`: a lost scheduler would
+    otherwise print Dask's tracebacks of every reconnection attempt, while the run reports
+    what matters in one line of its own (errors are one line unless asked for). With the
+    environment variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as
+    Dask logs them.
     """
 
     def __init__(
@@ -144,7 +156,7 @@ class DaskEvaluator:
         from distributed import Client, LocalCluster
 
         log_level = logging.INFO if os.environ.get("MTPG_DEBUG") else logging.CRITICAL
-        _set_dask_log_level(log_level)
+        self._log_levels = _set_dask_log_level(log_level)
         timeout = CONNECT_TIMEOUT if timeout is None else timeout
         self.address = address
         self.fallback_threads = fallback_threads
@@ -235,7 +247,7 @@ class DaskEvaluator:
 
     def _map(self, cp, roots, episodes, no_memory) -> list:
         n_ep = len(episodes.tasks)
-        n_batches = plan_batches(len(roots) * n_ep, n_ep, self.threads, self.min_roots)
+        n_batches = plan_batches(len(roots), self.threads, self.min_roots)
         [graph] = self.client.scatter([graph_arrays(cp)], broadcast=True, hash=False)
         table = self._table(episodes)
         episode_rows = np.arange(n_ep, dtype=np.int64)
@@ -289,6 +301,7 @@ class DaskEvaluator:
                 except Exception as exc:  # noqa: BLE001 - closing a dead cluster
                     print(f"closing the dask cluster: {exc}", file=sys.stderr)
         self.cluster = None
+        _restore_log_levels(self._log_levels)
 
 
 def _is_cluster_failure(exc: BaseException) -> bool:

@@ -31,6 +31,7 @@ from results_text import (  # noqa: E402 - the tool's own helper module beside i
     cost_rows,
     hierarchy_rows,
     markdown_table,
+    rescore_rows,
     status_rows,
 )
 
@@ -152,6 +153,18 @@ def build(results: Path, analyze: bool = True) -> Path:
     rows.append(["IQM over TPG seeds", "", *(e.text(2) for e in per_task)])
     lines += markdown_table(head, rows)
     lines += ["", f"IQM over TPG seeds and all tasks: {overall.text(2)}.", ""]
+    lines += [
+        "Every run's all-task champion: mean test return ± the half-width of its 95% "
+        f"confidence interval (1.96 std / sqrt(n), n = {runs[0].test_episodes} test "
+        "episodes, the scores of `tests.csv`), and in brackets the same graph re-scored on "
+        f"{runs[0].test_episodes} other held-out episodes (seed offset "
+        "500,000: `mtpg evaluate results/runs/RUN --seed 500000`). Two means over "
+        "independent blocks of episodes differ by less than 1.41 times the half-width "
+        "about 95% of the time.",
+        "",
+        *markdown_table(*rescore_rows(runs)),
+        "",
+    ]
     vs_single_rows = [
         [n.run.name, *(f"{x:.2f}" for x in _vs(n.test, best_single, tasks))]
         for n in (numbers[r.path] for g in groups for r in g.runs)

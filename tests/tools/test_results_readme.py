@@ -66,3 +66,16 @@ def test_the_page_quotes_the_numbers_of_the_report(results):
         n = run_numbers(load_run(results / "runs" / name))
         cells = [f"{n.normalised[t]:.2f}" for t in n.run.tasks]
         assert f"| {name} | {n.generation} | " + " | ".join(cells) + " |" in text
+
+
+def test_the_page_gives_each_champion_test_return_with_its_interval(results):
+    from mtpg.analysis.numbers import run_numbers
+    from mtpg.analysis.runs import load_run
+
+    text = results_readme.build(results, analyze=False).read_text()
+    n = run_numbers(load_run(results / "runs" / "TPG-seed2"))
+    row = next(
+        line for line in text.splitlines() if line.startswith("| TPG-seed2 |") and "±" in line
+    )
+    means = [float(cell.split("±")[0]) for cell in row.split("|")[3:-1]]
+    assert means == [float(f"{n.test[t]:.4g}") for t in n.run.tasks]

@@ -48,7 +48,7 @@ PLAN: tuple[tuple[str, int, str | None], ...] = (
     ("TPG-NoHierarchy-seed1", 1, "no-hierarchy"),
 )
 #: Test-point folders kept: generations divisible by this, and the newest.
-KEEP_TESTS_EVERY = 50
+KEEP_TESTS_EVERY = 100
 #: Seconds a run is given to commit after SIGTERM before it is told to stop at once.
 STOP_GRACE_S = 300
 PROVENANCE = "provenance.csv"

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
+from grow_results import KEEP_TESTS_EVERY  # noqa: E402
 from results_text import (  # noqa: E402 - the tool's own helper module beside it
     PAPER,
     ablation_rows,
@@ -40,7 +41,8 @@ GROWING = [
     "## Growing the runs",
     "",
     "Each run directory holds `config.toml`, `metrics.csv`, `tests.csv`, `champions/`, its "
-    "newest checkpoint, the test-point graphs of every 50th generation and of the latest "
+    f"newest checkpoint, the test-point graphs of every {KEEP_TESTS_EVERY}th generation and "
+    "of the latest "
     "test point (`tests/gen-NNNNNN/`; `tests.csv` has the scores of every test point), and "
     "`provenance.csv`: which mtpg commit ran which generations, when, for how long, on "
     "which processor. To continue them, from a clone of the repository:",

@@ -143,6 +143,17 @@ class EvaluationConfig:
     """Generations between tests of the champions (0: never)."""
     no_memory: bool = False
     """Ablation: zero every memory bank before each program execution."""
+    validation_episodes: int = 0
+    """Beyond the paper: validation episodes per task (seeds disjoint from training and
+    test); when > 0, each subset's champion is its best validated root among the best
+    ``validation_top_k`` by training fitness (docs/training.md). 0 (the paper): off."""
+    validation_top_k: int = 5
+    """Beyond the paper: candidates per subset of the validated champion choice (its
+    best surviving roots by training fitness); used only with ``validation_episodes``."""
+    resample_interval: int = 0
+    """Beyond the paper: every this many generations the training episodes are redrawn
+    (seeds disjoint from validation and test) and every surviving root is evaluated
+    again on them. 0 (the paper): one fixed set, each root evaluated once for life."""
 
     def __post_init__(self) -> None:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
@@ -160,7 +171,13 @@ class EvaluationConfig:
             self.tasks,
         )
         _positive(self, "evaluation", ("train_episodes", "test_episodes"))
-        _positive(self, "evaluation", ("test_interval",), minimum=0)
+        _positive(
+            self,
+            "evaluation",
+            ("test_interval", "validation_episodes", "resample_interval"),
+            minimum=0,
+        )
+        _positive(self, "evaluation", ("validation_top_k",))
 
     @property
     def n_subsets(self) -> int:
@@ -234,6 +251,12 @@ PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
         "team": {"root_size": 300, "n_elite": 4, "min_elite_total": 100},
         "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},
     },
+}
+
+#: Settings beyond the paper, by section: off at their defaults, where they are left out
+#: of a run's identity so that runs made before they existed keep theirs.
+EXTENSIONS: dict[str, tuple[str, ...]] = {
+    "evaluation": ("validation_episodes", "validation_top_k", "resample_interval"),
 }
 
 #: Ablation switches (section 5.2): each changes exactly one setting.

@@ -37,6 +37,9 @@ LIMITS: dict[str, int] = {
     "evaluation.train_episodes": 100_000,
     "evaluation.test_episodes": 1_000_000,
     "evaluation.test_interval": 100_000_000,
+    "evaluation.validation_episodes": 100_000,
+    "evaluation.validation_top_k": 100_000,
+    "evaluation.resample_interval": 100_000_000,
     "episodes": 1_000_000,
 }
 

@@ -34,6 +34,7 @@ SETTINGS: dict[str, list[str]] = {
     "validation": ["evaluation.validation_episodes=10", "evaluation.validation_top_k=5"],
     "resampling": ["evaluation.resample_interval=10"],
     "more-episodes": ["evaluation.train_episodes=9"],
+    "lexicase": ["team.parent_selection=lexicase"],
     "combined": [
         "evaluation.validation_episodes=10",
         "evaluation.validation_top_k=5",

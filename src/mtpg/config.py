@@ -16,6 +16,9 @@ from typing import Any
 
 from mtpg.envs.core import TASK_NAMES
 from mtpg.limits import LIMITS
+from mtpg.presets import ABLATIONS as ABLATIONS  # re-exported: presets live there
+from mtpg.presets import EXTENSIONS as EXTENSIONS
+from mtpg.presets import PARENT_SELECTIONS, PRESETS
 
 
 class ConfigError(ValueError):
@@ -115,6 +118,10 @@ class TeamConfig:
     """``p_atomic``: a changed action pointer becomes atomic with this probability."""
     max_team_size: int = 1000
     """Largest team allowed (the paper's is unbounded; this only guards memory)."""
+    parent_selection: str = "uniform"
+    """How parent 1 is drawn from a subset's elites: ``uniform`` (the paper) or, beyond
+    the paper, ``lexicase``: epsilon-lexicase over the subset's training episodes
+    (:mod:`mtpg.evolve.lexicase`)."""
 
     def __post_init__(self) -> None:
         _positive(self, "team", ("root_size", "n_elite", "max_team_size"))
@@ -127,6 +134,12 @@ class TeamConfig:
             self.max_team_size,
         )
         _probabilities(self, "team")
+        _check(
+            self.parent_selection in PARENT_SELECTIONS,
+            "team.parent_selection",
+            f"must be one of {', '.join(PARENT_SELECTIONS)}",
+            self.parent_selection,
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -239,32 +252,6 @@ class RunConfig:
         """True for the no-hierarchy ablation (``p_atomic = 1``)."""
         return self.team.p_atomic == 1.0
 
-
-#: Named presets: ``paper`` is the published run on all six tasks (Table 3, with 25 elites
-#: and 25 children per task subset: 1575 new roots per generation from 1000 initial
-#: roots); ``demo`` is small and quick.
-PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
-    "paper": {},
-    "demo": {
-        "generations": 250,
-        "workers": 2,
-        "team": {"root_size": 300, "n_elite": 4, "min_elite_total": 100},
-        "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},
-    },
-}
-
-#: Settings beyond the paper, by section: off at their defaults, where they are left out
-#: of a run's identity so that runs made before they existed keep theirs.
-EXTENSIONS: dict[str, tuple[str, ...]] = {
-    "evaluation": ("validation_episodes", "validation_top_k", "resample_interval"),
-}
-
-#: Ablation switches (section 5.2): each changes exactly one setting.
-ABLATIONS: dict[str, tuple[str, Any]] = {
-    "no-crossover": ("team.p_crossover", 0.0),
-    "no-memory": ("evaluation.no_memory", True),
-    "no-hierarchy": ("team.p_atomic", 1.0),
-}
 
 _SECTIONS = {"program": ProgramConfig, "team": TeamConfig, "evaluation": EvaluationConfig}
 

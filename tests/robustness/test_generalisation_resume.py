@@ -19,6 +19,7 @@ OPTIONS = {
     ],
     # blocks change at generations 3, 5 and 7: the resumed generations 4 and 5 redraw
     "resampling": ["--set", "evaluation.resample_interval=2"],
+    "lexicase": ["--set", "team.parent_selection=lexicase"],
 }
 
 
@@ -30,6 +31,9 @@ def test_killed_mid_generation_and_resumed_equals_the_uninterrupted_run(tmp_path
     header = (ref / "metrics.csv").read_text().splitlines()[0]
     assert ("validation_decisions" in header) == (option == "validation")
     assert ("reevaluated_roots" in header) == (option == "resampling")
+    assert ('parent_selection = "lexicase"' in (ref / "config.toml").read_text()) == (
+        option == "lexicase"
+    )
     run = tmp_path / "run"
     res = stop_at(run, "select:5:KILL", args)
     assert res.returncode == EXPECTED_CODES["KILL"], res.stderr

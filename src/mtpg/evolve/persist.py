@@ -96,11 +96,20 @@ def state_to_payload(state: TrainerState) -> dict[str, Any]:
 
 
 def _validation_payload(state: TrainerState) -> dict[str, Any]:
-    """The validation scores, stored only when validation is on (else no key at all)."""
-    if state.config.evaluation.validation_episodes == 0:
-        return {}
-    rows = sorted(state.validation.items())
-    return {"validation": [[int(root), [float(x) for x in row]] for root, row in rows]}
+    """Validation scores and per-episode returns, each stored only when its option is on.
+
+    With every option off (the paper) the payload has neither key, as before they existed.
+    """
+    out: dict[str, Any] = {}
+    if state.config.evaluation.validation_episodes > 0:
+        rows = sorted(state.validation.items())
+        out["validation"] = [[int(root), [float(x) for x in row]] for root, row in rows]
+    if state.config.team.parent_selection == "lexicase":
+        out["returns"] = [
+            [int(root), [[float(x) for x in task] for task in table]]
+            for root, table in sorted(state.returns.items())
+        ]
+    return out
 
 
 def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig]:
@@ -126,6 +135,9 @@ def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig
             rng=rng,
             validation={
                 int(r): np.array(row, dtype=np.float64) for r, row in payload.get("validation", [])
+            },
+            returns={
+                int(r): np.array(table, dtype=np.float64) for r, table in payload.get("returns", [])
             },
         )
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
@@ -164,6 +176,10 @@ def _check_consistent(state: TrainerState, payload: dict[str, Any]) -> None:
     bad = [r for r, row in state.validation.items() if row.shape != (n_tasks,)]
     if bad:
         raise FormatError(f"run state: root {bad[0]} has validation scores for the wrong tasks")
+    shape = (n_tasks, cfg.evaluation.train_episodes)
+    bad = [r for r, table in state.returns.items() if table.shape != shape or r not in pop.teams]
+    if bad:
+        raise FormatError(f"run state: root {bad[0]} has returns of the wrong shape or no team")
     if state.generation > 0:
         subsets = cfg.evaluation.n_subsets
         if len(state.champions) != subsets:

@@ -17,6 +17,7 @@ from mtpg.engine.compile import compile_population
 from mtpg.engine.evaluator import make_evaluator
 from mtpg.envs.core import TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds, resampled_training_seeds, validation_seeds
+from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
 from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
@@ -94,6 +95,8 @@ class TrainerState:
         rng: The generator of every random draw of the run.
         validation: Mean validation score per active task of every root measured on the
             validation episodes (only with ``evaluation.validation_episodes > 0``).
+        returns: Training return of every root per task and episode, ``[n_tasks,
+            train_episodes]`` (only with ``team.parent_selection = "lexicase"``).
     """
 
     config: RunConfig
@@ -104,6 +107,7 @@ class TrainerState:
     champions: list[int]
     rng: np.random.Generator
     validation: dict[int, np.ndarray] = field(default_factory=dict)
+    returns: dict[int, np.ndarray] = field(default_factory=dict)
 
     @classmethod
     def new(cls, config: RunConfig) -> TrainerState:
@@ -250,12 +254,19 @@ class Trainer:
         st = self.state
         varier = Varier(st.population, self.config, st.rng, gen)
         roots = sorted(st.scores)
+        lexicase = self.config.team.parent_selection == "lexicase"
         for k, elites in enumerate(st.elites):
             if k == len(st.elites) // 2:
                 point("vary", gen)
             pool = elites or roots
+            if lexicase:  # beyond the paper: parent 1 by epsilon-lexicase over episodes
+                cases = np.array([st.returns[r][list(self.subsets[k])].ravel() for r in pool])
+                eps = case_epsilons(cases)
             for _ in range(self.config.elites_per_subset):
-                parent1 = pool[int(st.rng.integers(0, len(pool)))]
+                if lexicase:
+                    parent1 = pool[lexicase_pick(cases, eps, st.rng)]
+                else:
+                    parent1 = pool[int(st.rng.integers(0, len(pool)))]
                 parent2 = roots[int(st.rng.integers(0, len(roots)))]
                 varier.child(parent1, parent2)
 
@@ -272,9 +283,12 @@ class Trainer:
         returns, result = self.evaluator.evaluate(
             cp, todo, self.training_episodes(gen), ev.no_memory
         )
-        means = returns.reshape(len(todo), len(self.task_ids), ev.train_episodes).mean(axis=2)
-        for root, row in zip(todo, means, strict=True):
+        per_episode = returns.reshape(len(todo), len(self.task_ids), ev.train_episodes)
+        for root, row in zip(todo, per_episode.mean(axis=2), strict=True):
             st.scores[root] = row
+        if self.config.team.parent_selection == "lexicase":
+            for root, table in zip(todo, per_episode, strict=True):
+                st.returns[root] = table
         new_roots = [r for r in todo if r not in survivors]
         return new_roots, result
 
@@ -292,6 +306,7 @@ class Trainer:
                 del pop.teams[rid]
                 del st.scores[rid]
                 st.validation.pop(rid, None)
+                st.returns.pop(rid, None)
         while True:  # internal teams whose last referrer died: never agents, deleted
             orphans = [t for t, d in pop.in_degree().items() if d == 0 and t not in keep]
             if not orphans:

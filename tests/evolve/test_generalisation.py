@@ -293,3 +293,29 @@ def test_a_paper_payload_has_no_validation_key() -> None:
     tr.run_generation()
     assert "validation" not in state_to_payload(tr.state)
     tr.close()
+
+
+def test_champion_files_record_their_validation_scores() -> None:
+    from mtpg.evolve.reporters import champion_graphs
+
+    tr = Trainer(tiny(*ON))
+    tr.run_generation()
+    for names, (_, root, meta) in champion_graphs(tr).items():
+        cols = [tr.config.evaluation.tasks.index(t) for t in names]
+        assert meta["validation_scores"] == {
+            t: float(tr.state.validation[root][c]) for t, c in zip(names, cols, strict=True)
+        }
+    tr.close()
+    paper = Trainer(tiny())
+    paper.run_generation()
+    assert all("validation_scores" not in m for _, _, m in champion_graphs(paper).values())
+    paper.close()
+
+
+def test_the_work_estimate_counts_validation_and_reevaluation() -> None:
+    from mtpg.limits import training_estimate
+
+    base = training_estimate(build_config("paper"))["decisions"]
+    val = training_estimate(build_config("paper", overrides=["evaluation.validation_episodes=50"]))
+    resampled = training_estimate(build_config("paper", overrides=RESAMPLE))
+    assert val["decisions"] > base and resampled["decisions"] > base

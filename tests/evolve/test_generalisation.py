@@ -319,3 +319,13 @@ def test_the_work_estimate_counts_validation_and_reevaluation() -> None:
     val = training_estimate(build_config("paper", overrides=["evaluation.validation_episodes=50"]))
     resampled = training_estimate(build_config("paper", overrides=RESAMPLE))
     assert val["decisions"] > base and resampled["decisions"] > base
+
+
+def test_with_every_option_on_one_or_two_workers_give_the_same_run() -> None:
+    every = [*ON, *RESAMPLE, 'team.parent_selection="lexicase"']
+    one, _, tests_one = _run(tiny(*every, "workers=1"), 4)
+    two, _, tests_two = _run(tiny(*every, "workers=2"), 4)
+    assert _state(one) == _state(two) and tests_one == tests_two
+    assert {r: t.tolist() for r, t in one.state.returns.items()} == {
+        r: t.tolist() for r, t in two.state.returns.items()
+    }

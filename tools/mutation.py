@@ -198,6 +198,12 @@ _OBS = ("tests/envs/test_observations.py",)
 _PARITY = ("tests/envs/test_gym_parity.py",)
 _OPS = ("tests/engine/test_ops_table.py",)
 _ENGINE = ("tests/engine/test_parity.py", "tests/engine/test_trace.py")
+_SELECTION = (
+    "tests/evolve/test_selection.py",
+    "tests/evolve/test_selection_oracles.py",
+    "tests/evolve/test_selection_rules.py",
+    "tests/evolve/test_generalisation.py",
+)
 
 #: Hand-written mutants of the compiled kernels and the task files.
 HAND_MUTANTS: tuple[HandMutant, ...] = (
@@ -424,6 +430,42 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
         "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m]",
         "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m + one]",
         _ENGINE,
+    ),
+    # the paper's selection rule (section 4.1) and the validated champion choice
+    HandMutant(
+        "selection-mean-not-min",
+        "src/mtpg/evolve/selection.py",
+        "fitness = norm[:, list(subset)].min(axis=1)",
+        "fitness = norm[:, list(subset)].mean(axis=1)",
+        _SELECTION,
+    ),
+    HandMutant(
+        "selection-max-not-min",
+        "src/mtpg/evolve/selection.py",
+        "fitness = norm[:, list(subset)].min(axis=1)",
+        "fitness = norm[:, list(subset)].max(axis=1)",
+        _SELECTION,
+    ),
+    HandMutant(
+        "selection-raw-not-normalised",
+        "src/mtpg/evolve/selection.py",
+        "    norm = normalise(scores)\n    out = []",
+        "    norm = scores\n    out = []",
+        _SELECTION,
+    ),
+    HandMutant(
+        "selection-normalise-without-shift",
+        "src/mtpg/evolve/selection.py",
+        "out[:, varied] = (scores[:, varied] - lo[varied]) / span[varied]",
+        "out[:, varied] = scores[:, varied] / span[varied]",
+        _SELECTION,
+    ),
+    HandMutant(
+        "validation-mean-not-min",
+        "src/mtpg/evolve/validation.py",
+        "return norm.min(axis=1)",
+        "return norm.mean(axis=1)",
+        _SELECTION,
     ),
 )
 

@@ -16,6 +16,9 @@ from typing import Any
 
 from mtpg.envs.core import TASK_NAMES
 from mtpg.limits import LIMITS
+from mtpg.presets import ABLATIONS as ABLATIONS  # re-exported: presets live there
+from mtpg.presets import EXTENSIONS as EXTENSIONS
+from mtpg.presets import PARENT_SELECTIONS, PRESETS
 
 
 class ConfigError(ValueError):
@@ -115,6 +118,10 @@ class TeamConfig:
     """``p_atomic``: a changed action pointer becomes atomic with this probability."""
     max_team_size: int = 1000
     """Largest team allowed (the paper's is unbounded; this only guards memory)."""
+    parent_selection: str = "uniform"
+    """How parent 1 is drawn from a subset's elites: ``uniform`` (the paper) or, beyond
+    the paper, ``lexicase``: epsilon-lexicase over the subset's training episodes
+    (:mod:`mtpg.evolve.lexicase`)."""
 
     def __post_init__(self) -> None:
         _positive(self, "team", ("root_size", "n_elite", "max_team_size"))
@@ -127,6 +134,12 @@ class TeamConfig:
             self.max_team_size,
         )
         _probabilities(self, "team")
+        _check(
+            self.parent_selection in PARENT_SELECTIONS,
+            "team.parent_selection",
+            f"must be one of {', '.join(PARENT_SELECTIONS)}",
+            self.parent_selection,
+        )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -143,6 +156,17 @@ class EvaluationConfig:
     """Generations between tests of the champions (0: never)."""
     no_memory: bool = False
     """Ablation: zero every memory bank before each program execution."""
+    validation_episodes: int = 0
+    """Beyond the paper: validation episodes per task (seeds disjoint from training and
+    test); when > 0, each subset's champion is its best validated root among the best
+    ``validation_top_k`` by training fitness (docs/training.md). 0 (the paper): off."""
+    validation_top_k: int = 5
+    """Beyond the paper: candidates per subset of the validated champion choice (its
+    best surviving roots by training fitness); used only with ``validation_episodes``."""
+    resample_interval: int = 0
+    """Beyond the paper: every this many generations the training episodes are redrawn
+    (seeds disjoint from validation and test) and every surviving root is evaluated
+    again on them. 0 (the paper): one fixed set, each root evaluated once for life."""
 
     def __post_init__(self) -> None:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
@@ -160,7 +184,13 @@ class EvaluationConfig:
             self.tasks,
         )
         _positive(self, "evaluation", ("train_episodes", "test_episodes"))
-        _positive(self, "evaluation", ("test_interval",), minimum=0)
+        _positive(
+            self,
+            "evaluation",
+            ("test_interval", "validation_episodes", "resample_interval"),
+            minimum=0,
+        )
+        _positive(self, "evaluation", ("validation_top_k",))
 
     @property
     def n_subsets(self) -> int:
@@ -222,26 +252,6 @@ class RunConfig:
         """True for the no-hierarchy ablation (``p_atomic = 1``)."""
         return self.team.p_atomic == 1.0
 
-
-#: Named presets: ``paper`` is the published run on all six tasks (Table 3, with 25 elites
-#: and 25 children per task subset: 1575 new roots per generation from 1000 initial
-#: roots); ``demo`` is small and quick.
-PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
-    "paper": {},
-    "demo": {
-        "generations": 250,
-        "workers": 2,
-        "team": {"root_size": 300, "n_elite": 4, "min_elite_total": 100},
-        "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},
-    },
-}
-
-#: Ablation switches (section 5.2): each changes exactly one setting.
-ABLATIONS: dict[str, tuple[str, Any]] = {
-    "no-crossover": ("team.p_crossover", 0.0),
-    "no-memory": ("evaluation.no_memory", True),
-    "no-hierarchy": ("team.p_atomic", 1.0),
-}
 
 _SECTIONS = {"program": ProgramConfig, "team": TeamConfig, "evaluation": EvaluationConfig}
 

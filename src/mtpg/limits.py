@@ -37,6 +37,9 @@ LIMITS: dict[str, int] = {
     "evaluation.train_episodes": 100_000,
     "evaluation.test_episodes": 1_000_000,
     "evaluation.test_interval": 100_000_000,
+    "evaluation.validation_episodes": 100_000,
+    "evaluation.validation_top_k": 100_000,
+    "evaluation.resample_interval": 100_000_000,
     "episodes": 1_000_000,
 }
 
@@ -106,8 +109,9 @@ def training_estimate(config: Any) -> dict[str, float]:
         config: A :class:`mtpg.config.RunConfig`.
 
     Returns:
-        ``population``, ``evaluation``, ``test``, ``checkpoint``, ``base`` and ``total``
-        bytes, and ``decisions`` (upper bound of one generation).
+        ``population``, ``evaluation``, ``test`` (or validation, the larger),
+        ``checkpoint``, ``base`` and ``total`` bytes, and ``decisions`` (upper bound of one
+        generation, validation and re-evaluation of survivors included).
     """
     from mtpg.envs.tasks import MAX_STEPS
 
@@ -124,9 +128,14 @@ def training_estimate(config: Any) -> dict[str, float]:
     train_eps = ev.train_episodes * len(steps)
     evaluation = evaluation_bytes(new_roots, train_eps, max(steps))
     test = evaluation_bytes(subsets, ev.test_episodes * len(steps), max(steps))
+    candidates = min(subsets * ev.validation_top_k, roots) if ev.validation_episodes else 0
+    validation = evaluation_bytes(candidates, ev.validation_episodes * len(steps), max(steps))
+    test = max(test, validation)  # validation happens between evaluation and test
     checkpoint = instructions * CHECKPOINT_INSTRUCTION_BYTES
     total = BASE_BYTES + population + max(evaluation, test, checkpoint)
-    decisions = float(new_roots) * ev.train_episodes * sum(steps)
+    evaluated = roots if ev.resample_interval else new_roots  # resampling: every root again
+    decisions = float(evaluated) * ev.train_episodes * sum(steps)
+    decisions += float(candidates) * ev.validation_episodes * sum(steps)
     return {
         "population": float(population),
         "evaluation": float(evaluation),

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from mtpg.config import ConfigError, RunConfig, from_dict, to_dict
+from mtpg.config import EXTENSIONS, ConfigError, RunConfig, from_dict, to_dict
 from mtpg.envs.core import N_OBS
 from mtpg.evolve.trainer import TrainerState
 from mtpg.io.serialize import FormatError, population_from_dict, population_to_dict
@@ -30,11 +30,28 @@ RESUMABLE_CHANGES = (
 )
 
 
-def identity_fields(config: RunConfig) -> dict[str, Any]:
+def _computing_fields(config: RunConfig) -> dict[str, Any]:
     """The resolved configuration without :data:`RESUMABLE_CHANGES`."""
     data = to_dict(config)
     for key in RESUMABLE_CHANGES:
         data.pop(key)
+    return data
+
+
+def identity_fields(config: RunConfig) -> dict[str, Any]:
+    """The resolved configuration without :data:`RESUMABLE_CHANGES`.
+
+    The settings beyond the paper (:data:`mtpg.config.EXTENSIONS`) are left out while they
+    hold their default (off) value, so a run made before they existed keeps its identity;
+    a field that is absent stands for its default, so two different configurations never
+    share their identity fields.
+    """
+    data = _computing_fields(config)
+    defaults = to_dict(RunConfig())
+    for section, names in EXTENSIONS.items():
+        for name in names:
+            if data[section][name] == defaults[section][name]:
+                del data[section][name]
     return data
 
 
@@ -51,7 +68,7 @@ def run_identity(config: RunConfig) -> str:
 def config_differences(a: RunConfig, b: RunConfig) -> list[str]:
     """Dotted names of the identity fields in which two configurations differ."""
     out = []
-    da, db = identity_fields(a), identity_fields(b)
+    da, db = _computing_fields(a), _computing_fields(b)
     for key in da:
         if isinstance(da[key], dict):
             out += [f"{key}.{k}" for k in da[key] if da[key][k] != db[key][k]]
@@ -75,7 +92,24 @@ def state_to_payload(state: TrainerState) -> dict[str, Any]:
         "elites": [[int(r) for r in e] for e in state.elites],
         "champions": [int(r) for r in state.champions],
         "rng": state.rng.bit_generator.state,
-    }
+    } | _validation_payload(state)
+
+
+def _validation_payload(state: TrainerState) -> dict[str, Any]:
+    """Validation scores and per-episode returns, each stored only when its option is on.
+
+    With every option off (the paper) the payload has neither key, as before they existed.
+    """
+    out: dict[str, Any] = {}
+    if state.config.evaluation.validation_episodes > 0:
+        rows = sorted(state.validation.items())
+        out["validation"] = [[int(root), [float(x) for x in row]] for root, row in rows]
+    if state.config.team.parent_selection == "lexicase":
+        out["returns"] = [
+            [int(root), [[float(x) for x in task] for task in table]]
+            for root, table in sorted(state.returns.items())
+        ]
+    return out
 
 
 def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig]:
@@ -99,6 +133,12 @@ def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig
             elites=[[int(r) for r in e] for e in payload["elites"]],
             champions=[int(r) for r in payload["champions"]],
             rng=rng,
+            validation={
+                int(r): np.array(row, dtype=np.float64) for r, row in payload.get("validation", [])
+            },
+            returns={
+                int(r): np.array(table, dtype=np.float64) for r, table in payload.get("returns", [])
+            },
         )
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         if isinstance(exc, FormatError):
@@ -130,6 +170,16 @@ def _check_consistent(state: TrainerState, payload: dict[str, Any]) -> None:
     bad = [r for r, row in state.scores.items() if row.shape != (n_tasks,)]
     if bad:
         raise FormatError(f"run state: root {bad[0]} has scores for the wrong number of tasks")
+    unscored = [r for r in state.validation if r not in state.scores]
+    if unscored:
+        raise FormatError(f"run state: validated root {unscored[0]} is not a scored root")
+    bad = [r for r, row in state.validation.items() if row.shape != (n_tasks,)]
+    if bad:
+        raise FormatError(f"run state: root {bad[0]} has validation scores for the wrong tasks")
+    shape = (n_tasks, cfg.evaluation.train_episodes)
+    bad = [r for r, table in state.returns.items() if table.shape != shape or r not in pop.teams]
+    if bad:
+        raise FormatError(f"run state: root {bad[0]} has returns of the wrong shape or no team")
     if state.generation > 0:
         subsets = cfg.evaluation.n_subsets
         if len(state.champions) != subsets:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from mtpg.config import EvaluationConfig
 from mtpg.evolve.persist import state_to_payload
 from mtpg.evolve.trainer import Trainer, held_out_columns, metric_columns
 from mtpg.io.checkpoint import checkpoint_path, prune_checkpoints, save_checkpoint
@@ -134,8 +135,10 @@ def train(
 class MetricsReporter(Reporter):
     """Appends each generation's row to ``metrics.csv``."""
 
-    def __init__(self, path: Path, tasks: tuple[str, ...]) -> None:
-        self.writer = MetricsWriter(path, metric_columns(tasks))
+    def __init__(
+        self, path: Path, tasks: tuple[str, ...], evaluation: EvaluationConfig | None = None
+    ) -> None:
+        self.writer = MetricsWriter(path, metric_columns(tasks, evaluation))
 
     def generation(self, gen: Generation, trainer: Trainer) -> None:
         """Appends the row."""
@@ -207,6 +210,11 @@ def champion_graphs(trainer: Trainer) -> dict[tuple[str, ...], tuple[Any, int, d
             "train_scores": {t: float(scores[cfg.evaluation.tasks.index(t)]) for t in names},
             "no_memory": cfg.evaluation.no_memory,
         }
+        if root in state.validation:  # chosen on the validation episodes (beyond the paper)
+            val = state.validation[root]
+            meta["validation_scores"] = {
+                t: float(val[cfg.evaluation.tasks.index(t)]) for t in names
+            }
         out[names] = (state.population, root, meta)
     return out
 

@@ -33,14 +33,37 @@ def normalise(scores: np.ndarray) -> np.ndarray:
     return out
 
 
+def rankings(
+    root_ids: np.ndarray, scores: np.ndarray, subsets: list[tuple[int, ...]]
+) -> list[np.ndarray]:
+    """Every subset's ranking of the roots by its fitness, best first.
+
+    A subset's fitness of a root is its minimum normalised score (:func:`normalise`) over
+    the subset's tasks (paper section 4.1); ties go to the younger root (higher id).
+
+    Args:
+        root_ids: int64 ``[n_roots]`` team ids.
+        scores: float64 ``[n_roots, n_tasks]`` mean training scores.
+        subsets: Task subsets.
+
+    Returns:
+        For each subset, int ``[n_roots]`` row indices into ``root_ids``, best first.
+    """
+    norm = normalise(scores)
+    out = []
+    for subset in subsets:
+        fitness = norm[:, list(subset)].min(axis=1)
+        out.append(np.lexsort((-root_ids, -fitness)))
+    return out
+
+
 def select(
     root_ids: np.ndarray, scores: np.ndarray, subsets: list[tuple[int, ...]], n_elite: int
 ) -> tuple[list[list[int]], list[int]]:
     """Chooses the elites of every task subset and its champion.
 
-    A subset's fitness of a root is its minimum normalised score over the subset's tasks.
-    Roots are ranked by fitness, ties to the younger root (higher id). Each subset keeps
-    its ``n_elite`` best roots not already kept by an earlier subset.
+    Roots are ranked by each subset's fitness (:func:`rankings`). Each subset keeps its
+    ``n_elite`` best roots not already kept by an earlier subset.
 
     Args:
         root_ids: int64 ``[n_roots]`` team ids.
@@ -52,14 +75,37 @@ def select(
         The elites of each subset (team ids, best first) and each subset's champion
         (its best root, whether or not an earlier subset kept it).
     """
-    norm = normalise(scores)
     kept = np.zeros(len(root_ids), dtype=bool)
     elites, champions = [], []
-    for subset in subsets:
-        fitness = norm[:, list(subset)].min(axis=1)
-        order = np.lexsort((-root_ids, -fitness))
+    for order in rankings(root_ids, scores, subsets):
         champions.append(int(root_ids[order[0]]))
         free = order[~kept[order]][:n_elite]
         kept[free] = True
         elites.append([int(root_ids[i]) for i in free])
     return elites, champions
+
+
+def candidates(
+    root_ids: np.ndarray, orders: list[np.ndarray], kept: set[int], k: int
+) -> list[list[int]]:
+    """Each subset's best ``k`` surviving roots by training fitness, best first.
+
+    Args:
+        root_ids: int64 ``[n_roots]`` team ids.
+        orders: The subsets' rankings (:func:`rankings`).
+        kept: The roots that survive selection (every subset's elites).
+        k: Candidates per subset.
+
+    Returns:
+        Team ids per subset; the first is the subset's champion by training fitness.
+    """
+    out = []
+    for order in orders:
+        chosen: list[int] = []
+        for i in order:
+            if int(root_ids[i]) in kept:
+                chosen.append(int(root_ids[i]))
+                if len(chosen) == k:
+                    break
+        out.append(chosen)
+    return out

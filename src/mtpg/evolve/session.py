@@ -171,7 +171,7 @@ class Session:
         gen = self.trainer.state.generation
         tasks = self.config.evaluation.tasks
         roll_back(self.run.path, gen)
-        self.metrics = MetricsReporter(self.run.metrics, tasks)
+        self.metrics = MetricsReporter(self.run.metrics, tasks, self.config.evaluation)
         self.metrics.writer.truncate_after(gen)
         self.tests = TestsReporter(self.run.path, tasks)
         self.tests.writer.truncate_after(gen)

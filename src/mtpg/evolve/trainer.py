@@ -7,17 +7,19 @@ champions from what :meth:`Trainer.run_generation` returns.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from mtpg.config import RunConfig
+from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.evaluator import make_evaluator
 from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.protocol import held_out_seeds, training_seeds
-from mtpg.evolve.selection import select, task_subsets
+from mtpg.envs.protocol import held_out_seeds, resampled_training_seeds, validation_seeds
+from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
+from mtpg.evolve.selection import candidates, rankings, select, task_subsets
+from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
 from mtpg.testhook import point
@@ -40,8 +42,26 @@ def held_out_columns(tasks: tuple[str, ...]) -> list[str]:
     ]
 
 
-def metric_columns(tasks: tuple[str, ...]) -> list[str]:
-    """The ``metrics.csv`` header for a run on ``tasks``."""
+def extra_columns(evaluation: EvaluationConfig | None) -> list[str]:
+    """Columns of the settings beyond the paper that are on (none in ``paper``).
+
+    ``validated_roots`` and ``validation_decisions``: roots first measured on the
+    validation episodes this generation and the decisions that took (validation on);
+    ``reevaluated_roots``: surviving roots evaluated again on redrawn training episodes
+    this generation (resampling on; their decisions are in ``decisions``).
+    """
+    if evaluation is None:
+        return []
+    cols = []
+    if evaluation.validation_episodes > 0:
+        cols += ["validated_roots", "validation_decisions"]
+    if evaluation.resample_interval > 0:
+        cols.append("reevaluated_roots")
+    return cols
+
+
+def metric_columns(tasks: tuple[str, ...], evaluation: EvaluationConfig | None = None) -> list[str]:
+    """The ``metrics.csv`` header for a run on ``tasks`` (with ``evaluation``'s extras)."""
     cols = [
         "generation",
         "roots",
@@ -58,7 +78,7 @@ def metric_columns(tasks: tuple[str, ...]) -> list[str]:
     ]
     for task in tasks:
         cols += [f"best_{task}", f"median_{task}"]
-    return cols + list(TIMING_COLUMNS)
+    return cols + extra_columns(evaluation) + list(TIMING_COLUMNS)
 
 
 @dataclass
@@ -73,6 +93,10 @@ class TrainerState:
         elites: Elite root ids of each task subset (``task_subsets`` order).
         champions: Best root id of each task subset.
         rng: The generator of every random draw of the run.
+        validation: Mean validation score per active task of every root measured on the
+            validation episodes (only with ``evaluation.validation_episodes > 0``).
+        returns: Training return of every root per task and episode, ``[n_tasks,
+            train_episodes]`` (only with ``team.parent_selection = "lexicase"``).
     """
 
     config: RunConfig
@@ -82,6 +106,8 @@ class TrainerState:
     elites: list[list[int]]
     champions: list[int]
     rng: np.random.Generator
+    validation: dict[int, np.ndarray] = field(default_factory=dict)
+    returns: dict[int, np.ndarray] = field(default_factory=dict)
 
     @classmethod
     def new(cls, config: RunConfig) -> TrainerState:
@@ -104,9 +130,32 @@ class Trainer:
         ev = config.evaluation
         self.task_ids = list(ev.task_ids)
         self.subsets = task_subsets(len(self.task_ids))
-        seeds = training_seeds(ev.train_episodes)
-        self.episodes = Episodes.grid(self.task_ids, seeds)
+        self._block: tuple[int, Episodes] | None = None
+        self._extra: dict[str, float] = {}
+        self.validation_table = (
+            Episodes.grid(self.task_ids, validation_seeds(ev.validation_episodes))
+            if ev.validation_episodes > 0
+            else None
+        )
         self.evaluator = make_evaluator(config)
+
+    def training_block(self, gen: int) -> int:
+        """The training block of generation ``gen``: 0 unless resampling is on.
+
+        With ``evaluation.resample_interval = G``, generations 1..G use block 0 (seeds
+        0..n-1, as the paper), G+1..2G block 1, and so on.
+        """
+        interval = self.config.evaluation.resample_interval
+        return (gen - 1) // interval if interval > 0 else 0
+
+    def training_episodes(self, gen: int) -> Episodes:
+        """The training episodes of generation ``gen`` (the last block's table is cached)."""
+        block = self.training_block(gen)
+        if self._block is None or self._block[0] != block:
+            ev = self.config.evaluation
+            seeds = resampled_training_seeds(self.config.seed, block, ev.train_episodes)
+            self._block = (block, Episodes.grid(self.task_ids, seeds))
+        return self._block[1]
 
     def close(self) -> None:
         """Releases the evaluation backend (a Dask cluster started for the run)."""
@@ -131,10 +180,16 @@ class Trainer:
         root is deleted, followed by internal teams no longer referenced, programs no
         team holds and banks no program points to; then fresh banks are added until there
         are at least as many banks as teams.
+
+        Beyond the paper: when the generation starts a new training block (resampling
+        on), the surviving roots are evaluated again with the children, on the new
+        block's episodes; with validation on, the champions are then chosen on the
+        validation episodes (:mod:`mtpg.evolve.validation`).
         """
         st, cfg = self.state, self.config
         self.evaluator.check()  # a lost cluster stops the run here, between generations
         gen = st.generation + 1
+        self._extra = {}
         t0 = time.perf_counter()
         if gen == 1:
             st.population = init_population(cfg, st.rng)
@@ -142,7 +197,7 @@ class Trainer:
             self._vary(gen)
         t1 = time.perf_counter()
         point("evaluate", gen)
-        new_roots, result = self._evaluate()
+        new_roots, result = self._evaluate(gen)
         t2 = time.perf_counter()
         point("select", gen)
         self._select()
@@ -199,26 +254,42 @@ class Trainer:
         st = self.state
         varier = Varier(st.population, self.config, st.rng, gen)
         roots = sorted(st.scores)
+        lexicase = self.config.team.parent_selection == "lexicase"
         for k, elites in enumerate(st.elites):
             if k == len(st.elites) // 2:
                 point("vary", gen)
             pool = elites or roots
+            if lexicase:  # beyond the paper: parent 1 by epsilon-lexicase over episodes
+                cases = np.array([st.returns[r][list(self.subsets[k])].ravel() for r in pool])
+                eps = case_epsilons(cases)
             for _ in range(self.config.elites_per_subset):
-                parent1 = pool[int(st.rng.integers(0, len(pool)))]
+                if lexicase:
+                    parent1 = pool[lexicase_pick(cases, eps, st.rng)]
+                else:
+                    parent1 = pool[int(st.rng.integers(0, len(pool)))]
                 parent2 = roots[int(st.rng.integers(0, len(roots)))]
                 varier.child(parent1, parent2)
 
-    def _evaluate(self):
-        st = self.state
-        new_roots = [r for r in st.population.roots() if r not in st.scores]
+    def _evaluate(self, gen: int):
+        st, ev = self.state, self.config.evaluation
+        survivors: set[int] = set()
+        if ev.resample_interval > 0:
+            if gen > 1 and self.training_block(gen) != self.training_block(gen - 1):
+                survivors = set(st.scores)
+                st.scores.clear()  # new episodes: every surviving root is scored again
+            self._extra["reevaluated_roots"] = len(survivors)
+        todo = [r for r in st.population.roots() if r not in st.scores]
         cp = compile_population(st.population)
         returns, result = self.evaluator.evaluate(
-            cp, new_roots, self.episodes, self.config.evaluation.no_memory
+            cp, todo, self.training_episodes(gen), ev.no_memory
         )
-        n_ep = self.config.evaluation.train_episodes
-        means = returns.reshape(len(new_roots), len(self.task_ids), n_ep).mean(axis=2)
-        for root, row in zip(new_roots, means, strict=True):
+        per_episode = returns.reshape(len(todo), len(self.task_ids), ev.train_episodes)
+        for root, row in zip(todo, per_episode.mean(axis=2), strict=True):
             st.scores[root] = row
+        if self.config.team.parent_selection == "lexicase":
+            for root, table in zip(todo, per_episode, strict=True):
+                st.returns[root] = table
+        new_roots = [r for r in todo if r not in survivors]
         return new_roots, result
 
     def _select(self) -> None:
@@ -234,6 +305,8 @@ class Trainer:
             if rid not in keep:
                 del pop.teams[rid]
                 del st.scores[rid]
+                st.validation.pop(rid, None)
+                st.returns.pop(rid, None)
         while True:  # internal teams whose last referrer died: never agents, deleted
             orphans = [t for t, d in pop.in_degree().items() if d == 0 and t not in keep]
             if not orphans:
@@ -242,6 +315,27 @@ class Trainer:
                 del pop.teams[t]
         pop.prune()  # programs no team holds, then banks no program points to
         pop.top_up_banks(len(pop.teams))  # the bank population: at least one bank per team
+        if self.validation_table is not None:
+            orders = rankings(root_ids, scores, self.subsets)
+            self._validate(
+                candidates(root_ids, orders, keep, self.config.evaluation.validation_top_k)
+            )
+
+    def _validate(self, cands: list[list[int]]) -> None:
+        """Chooses the champions among ``cands`` on the validation episodes."""
+        st, ev = self.state, self.config.evaluation
+        todo = sorted({r for c in cands for r in c} - set(st.validation))
+        decisions = 0
+        if todo:
+            cp = compile_population(st.population)
+            returns, result = self.evaluator.evaluate(cp, todo, self.validation_table, ev.no_memory)
+            n_ep = ev.validation_episodes
+            means = returns.reshape(len(todo), len(self.task_ids), n_ep).mean(axis=2)
+            for root, row in zip(todo, means, strict=True):
+                st.validation[root] = row
+            decisions = int(result.steps.sum())
+        st.champions = choose(cands, st.validation, self.subsets, self.task_ids)
+        self._extra.update(validated_roots=len(todo), validation_decisions=decisions)
 
     def _metrics(self, new_roots, result, times) -> dict[str, float]:
         st, pop = self.state, self.state.population
@@ -265,6 +359,7 @@ class Trainer:
         for k, task in enumerate(self.task_ids):
             row[f"best_{TASK_NAMES[task]}"] = float(scores[:, k].max())
             row[f"median_{TASK_NAMES[task]}"] = float(np.median(scores[:, k]))
+        row.update(self._extra)
         t0, t1, t2, t3 = times
         row.update(
             decisions_per_s=decisions / max(t2 - t1, 1e-9),

@@ -1,0 +1,38 @@
+"""Named presets, ablation switches and the settings beyond the paper (data only).
+
+Re-exported by :mod:`mtpg.config`, which validates them like any other settings.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: Ways of drawing parent 1 from a subset's elites (``team.parent_selection``).
+PARENT_SELECTIONS = ("uniform", "lexicase")
+
+#: Named presets: ``paper`` is the published run on all six tasks (Table 3, with 25 elites
+#: and 25 children per task subset: 1575 new roots per generation from 1000 initial
+#: roots); ``demo`` is small and quick.
+PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
+    "paper": {},
+    "demo": {
+        "generations": 250,
+        "workers": 2,
+        "team": {"root_size": 300, "n_elite": 4, "min_elite_total": 100},
+        "evaluation": {"train_episodes": 3, "test_episodes": 20, "test_interval": 5},
+    },
+}
+
+#: Settings beyond the paper, by section: off at their defaults, where they are left out
+#: of a run's identity so that runs made before they existed keep theirs.
+EXTENSIONS: dict[str, tuple[str, ...]] = {
+    "team": ("parent_selection",),
+    "evaluation": ("validation_episodes", "validation_top_k", "resample_interval"),
+}
+
+#: Ablation switches (section 5.2): each changes exactly one setting.
+ABLATIONS: dict[str, tuple[str, Any]] = {
+    "no-crossover": ("team.p_crossover", 0.0),
+    "no-memory": ("evaluation.no_memory", True),
+    "no-hierarchy": ("team.p_atomic", 1.0),
+}

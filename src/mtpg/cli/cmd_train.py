@@ -38,6 +38,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--dask-workers", type=int, metavar="N", help="start a local Dask cluster of N processes"
     )
     p.add_argument(
+        "--scheduler-wait",
+        type=float,
+        metavar="SECONDS",
+        help="seconds to wait for a Dask scheduler to connect or come back before the "
+        "generation is finished on this machine (default: 10, or $MTPG_SCHEDULER_WAIT); "
+        "not stored with the run",
+    )
+    p.add_argument(
         "--set",
         action="append",
         default=[],
@@ -99,7 +107,31 @@ def _fresh_dir(base: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs the command.
+    """Runs the command, with ``--scheduler-wait`` in force (and put back) around it."""
+    import os
+
+    from mtpg.cli.main import UsageError
+    from mtpg.engine.dask_backend import SCHEDULER_WAIT_ENV
+
+    if args.scheduler_wait is None:
+        return _train(args)
+    if not 0 < args.scheduler_wait <= 3600:
+        raise UsageError(
+            f"--scheduler-wait must be in (0, 3600] seconds, got {args.scheduler_wait}"
+        )
+    old = os.environ.get(SCHEDULER_WAIT_ENV)
+    os.environ[SCHEDULER_WAIT_ENV] = repr(args.scheduler_wait)
+    try:
+        return _train(args)
+    finally:
+        if old is None:
+            del os.environ[SCHEDULER_WAIT_ENV]
+        else:
+            os.environ[SCHEDULER_WAIT_ENV] = old
+
+
+def _train(args: argparse.Namespace) -> int:
+    """Trains or resumes.
 
     Stop signals (SIGTERM, SIGINT, SIGHUP) end the run after the generation under way is
     complete and committed; a second one stops at once. Either way the exit status is

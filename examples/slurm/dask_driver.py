@@ -59,7 +59,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         "--prologue",
         action="append",
         default=[],
-        help="shell line run before each worker starts (repeatable)",
+        help="shell line run before each worker starts (repeatable); the driver's "
+        "virtual environment, if any, is activated first",
     )
     p.add_argument("--no-tls", action="store_true", help="plain TCP: no authentication")
     p.add_argument(
@@ -87,6 +88,13 @@ def security(args: argparse.Namespace) -> Any:
         sys.exit("dask_driver: TLS needs the cryptography package (pip install cryptography)")
 
 
+def venv_prologue() -> list[str]:
+    """The line that activates this Python's virtual environment on a worker, if any."""
+    if sys.prefix == sys.base_prefix:
+        return []
+    return [f"source {shlex.quote(str(Path(sys.prefix) / 'bin' / 'activate'))}"]
+
+
 def slurm_cluster(args: argparse.Namespace, sec: Any) -> Any:
     """A ``SLURMCluster`` of one-thread worker processes, ``args.cores`` per job."""
     from dask_jobqueue import SLURMCluster
@@ -104,6 +112,7 @@ def slurm_cluster(args: argparse.Namespace, sec: Any) -> Any:
         memory=args.memory,
         walltime=args.walltime,
         job_script_prologue=[
+            *venv_prologue(),
             *args.prologue,
             'export NUMBA_CACHE_DIR="/tmp/$USER-numba"',  # node-local kernel cache
         ],

@@ -10,6 +10,16 @@ ABLATION_FLAGS = {
     "no_memory": "no-memory",
     "no_hierarchy": "no-hierarchy",
 }
+#: What each ablation switch does (section 5.2), for ``--help``.
+ABLATION_HELP = {
+    "no_crossover": "ablation TPG-NoXover: children are mutated copies of one parent, never "
+    "crossovers "
+    "(team.p_crossover=0)",
+    "no_memory": "ablation TPG-NoMemory: memory banks zeroed before every program execution "
+    "(evaluation.no_memory=true)",
+    "no_hierarchy": "ablation TPG-NoHierarchy: action pointers always atomic, no graphs "
+    "(team.p_atomic=1)",
+}
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -25,9 +35,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--config", metavar="FILE", help="TOML file of settings")
     p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
-    p.add_argument("--generations", type=int, help="generations to run")
-    p.add_argument("--seed", type=int, help="run seed")
-    p.add_argument("--workers", type=int, help="threads evaluating episodes")
+    p.add_argument(
+        "--generations",
+        type=int,
+        help="generations to run (default: the preset's: 1000 paper, 250 demo)",
+    )
+    p.add_argument("--seed", type=int, help="run seed (default 0)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="threads evaluating episodes (default: the preset's: 1 paper, 2 demo; give "
+        "--workers 2 or more for paper runs; results do not depend on it)",
+    )
     p.add_argument(
         "--backend",
         choices=("local", "dask"),
@@ -50,10 +69,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         action="append",
         default=[],
         metavar="SECTION.FIELD=VALUE",
-        help="override any setting, e.g. --set team.n_elite=10 (repeatable)",
+        help="override any setting, e.g. --set team.n_elite=10; top-level fields take no "
+        "section, e.g. --set checkpoint_interval=5 (repeatable; fields: mtpg.config)",
     )
     for dest, name in ABLATION_FLAGS.items():
-        p.add_argument(f"--{name}", dest=dest, action="store_true", help=f"ablation: {name}")
+        p.add_argument(f"--{name}", dest=dest, action="store_true", help=ABLATION_HELP[dest])
     where = p.add_mutually_exclusive_group()
     where.add_argument(
         "--out", metavar="RUN_DIR", help="new run directory (default: runs/<preset>-seed<seed>)"

@@ -140,8 +140,13 @@ class Progress:
             self._header_done = True
 
     def begin(self, generation: int = 0) -> None:
-        """Prints the header and a line saying the next generation compiles first."""
+        """Prints the header and a line saying the next generation compiles first.
+
+        A run that has no generation left (a finished run resumed) gets the header only.
+        """
         self._write_header()
+        if generation >= self.total:
+            return
         text = (
             f"gen {generation + 1}/{self.total}: compiling the engine's kernels (cached after "
             "the first run), then evaluating..."

@@ -131,6 +131,8 @@ class Progress:
             "root may differ per task, so this is not the champion's score)\n"
             f"  test@G = the all-task champion's mean return on {test} per task at the last "
             "test point G (what `mtpg report` and `mtpg evaluate` show)\n"
+            "  teams/dec = teams visited per decision, mean over the generation's new roots in "
+            "training (1: no team passes the decision on)\n"
             f"  tasks: {names}"
         )
 

@@ -92,3 +92,36 @@ def test_usr1_stops_the_run_closes_the_cluster_and_the_requeued_job_resumes(tmp_
     for name in a:  # config.toml and checkpoints name the backend; results do not depend on it
         if name.startswith(("champions/", "tests/")) or name in ("metrics.csv", "tests.csv"):
             assert a[name] == b[name], name
+
+
+class FakeChild:
+    def __init__(self):
+        self.signals = []
+
+    def send_signal(self, sig):
+        self.signals.append(sig)
+
+
+@pytest.mark.parametrize("in_slurm", [True, False])
+def test_stop_signals_reach_the_run_once(in_slurm):
+    import signal
+
+    driver = load_driver()
+    stopper = driver.Stopper(in_slurm=in_slurm)
+    stopper.child = child = FakeChild()
+    stopper(signal.SIGTERM, None)  # in SLURM, the run got this SIGTERM itself
+    assert child.signals == ([] if in_slurm else [signal.SIGTERM])
+    child.signals.clear()
+    for sig in (signal.SIGUSR1, signal.SIGINT, signal.SIGHUP):
+        stopper(sig, None)
+    assert child.signals == [signal.SIGTERM] * 3
+
+
+def test_a_signal_before_the_run_starts_means_the_run_is_not_started():
+    import signal
+
+    driver = load_driver()
+    stopper = driver.Stopper(in_slurm=True)
+    stopper(signal.SIGTERM, None)  # no run yet: remembered
+    assert stopper.requested
+    assert stopper.run(["false"], {}) == 128 + signal.SIGTERM and stopper.child is None

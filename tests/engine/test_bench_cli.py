@@ -74,3 +74,15 @@ def test_bench_engine_c_port_matches_and_is_timed(capsys):
     result = json.loads(out.strip().splitlines()[-1])
     assert result["c_decisions_per_s"] > 0 and result["engine_vs_c"] > 0
     assert len(result["engine_vs_c_all"]) == 2
+
+
+@pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
+def test_bench_engine_c_defaults_to_o3_with_o2_beside(capsys):
+    argv = ["bench", "engine", "--graphs", "20", "--episodes", "2", "--repeats", "1", "--c"]
+    assert main([*argv, "--reference-graphs", "0", "--no-pytpg"]) == 0
+    out = capsys.readouterr().out
+    result = json.loads(out.strip().splitlines()[-1])
+    assert result["c_flags"] == "-O3 -march=native"
+    assert result["c_beside"]["c_flags"] == "-O2 -march=native"
+    assert result["c_beside"]["engine_vs_c"] > 0
+    assert "C built with -O2 -march=native:" in out

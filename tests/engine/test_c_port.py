@@ -42,3 +42,38 @@ def test_check_names_the_first_differing_job(port, tmp_path):
 def test_fast_math_yardstick_is_refused(tmp_path, flags):
     with pytest.raises(ValueError, match="fast-math"):
         c_port.build(tmp_path, flags=flags)
+
+
+def test_limits_are_compile_time_constants_checked_against_the_input(tmp_path):
+    """The limits are -D constants; an input with other limits is refused, not used."""
+    src = c_port.source()
+    assert "static double BIG" not in src and "MTPG_BIG" in src
+    assert "memset(W, 0, g->R" not in src  # no memset per program run
+    exe = c_port.build(tmp_path)
+    work = make_workload(5, episodes=2, seed=2)
+    data = tmp_path / "w.bin"
+    c_port.write_input(work, data)
+    raw = bytearray(data.read_bytes())
+    raw[12 * 8 : 13 * 8] = np.float64(1e9).tobytes()  # BIG, right after the header
+    data.write_bytes(bytes(raw))
+    with pytest.raises(RuntimeError, match="protection limits differ"):
+        c_port.run_port(exe, data, len(work.job_roots))
+
+
+def test_every_pass_repeats_the_work_and_bad_passes_are_refused(tmp_path):
+    """Warm passes redo the same jobs from fresh buffers, so the timed one equals the first."""
+    import subprocess
+
+    exe = c_port.build(tmp_path)
+    work = make_workload(30, episodes=2, seed=3)
+    data = tmp_path / "w.bin"
+    c_port.write_input(work, data)
+    outs = []
+    for passes in ("1", "3"):
+        out = tmp_path / f"out{passes}"
+        done = subprocess.run([str(exe), str(data), str(out), passes], capture_output=True)
+        assert done.returncode == 0
+        outs.append(out.read_bytes())
+    assert outs[0] == outs[1]
+    bad = subprocess.run([str(exe), str(data), str(tmp_path / "x"), "0"], capture_output=True)
+    assert bad.returncode == 2 and b"PASSES" in bad.stderr

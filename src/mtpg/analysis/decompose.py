@@ -1,4 +1,4 @@
-"""Task decomposition by team (paper Fig. 12): where in state space each team runs.
+"""Task decomposition by team (paper Fig. 10): where in state space each team runs.
 
 For one task's replay, each team gets the points ``(observed variable, hidden velocity)``
 of the steps at which it was visited; a point is *final* when the team chose the action

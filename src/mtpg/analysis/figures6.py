@@ -99,7 +99,7 @@ def register_access(access: dict, path: Path, title: str) -> Path:
 
 
 def time_series(task: str, series: dict, prediction: dict, path: Path, title: str) -> Path:
-    """Figs. 10-11: complexity, memory window and velocity prediction of one episode."""
+    """Figs. 11-12: complexity, memory window and velocity prediction of one episode."""
     plt = pyplot()
     colour = task_colour(task)
     fig, axes = plt.subplots(4, 1, figsize=(7.5, 8.2), sharex=True)
@@ -151,7 +151,7 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
 
 
 def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path:
-    """Fig. 12: one panel per team, points where it ran, coloured by action when final."""
+    """Fig. 10: one panel per team, points where it ran, coloured by action when final."""
     plt = pyplot()
     from matplotlib.lines import Line2D
 

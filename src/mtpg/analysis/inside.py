@@ -110,7 +110,7 @@ def register_access(replays: dict[str, Replay]) -> dict[str, np.ndarray]:
 
 
 def step_series(replay: Replay, episode: int = 0) -> dict[str, np.ndarray]:
-    """Per-step complexity and memory window of one episode (Figs. 10-11, top rows).
+    """Per-step complexity and memory window of one episode (Figs. 11-12, top rows).
 
     Returns:
         ``step`` (n,), ``teams`` teams visited, ``instructions`` instructions executed,

@@ -16,7 +16,7 @@ For each run:
   generation, again chosen by training score (never by test score), and its test score on
   that task; ``vs single`` is ``(test - random) / (that score - random)``, undefined (NaN)
   when that champion does no better than random play.
-- **Best run** of a group (the black line of Figs. 3-4, the bars of Figs. 5-6): the run
+- **Best run** of a group (the black line of Fig. 4, the bars of Figs. 5-7): the run
   whose all-task champion has the highest minimum over tasks of its reference-normalised
   *training* score (ties, e.g. a task no run has learnt, broken by the highest mean), so no
   test result decides which run is shown as best.

@@ -28,7 +28,7 @@ from mtpg.model.graph import Population
 
 
 def default_decompose_task(tasks: list[str]) -> str:
-    """Pendulum when analysed (the paper's Fig. 12a), else the first task."""
+    """Pendulum when analysed (the paper's Fig. 10a), else the first task."""
     return "Pendulum" if "Pendulum" in tasks else tasks[0]
 
 
@@ -144,7 +144,7 @@ def build_analysis(
             f"{task}: the test episode of median return\n(seed {int(one['episode_seeds'][0])}, "
             f"return {one['returns'][0]:.2f}, {one.n_steps} steps)",
         )
-        sections.append(_img(files[name], f"{task}: run-time dynamics (Figs. 10-11)"))
+        sections.append(_img(files[name], f"{task}: run-time dynamics (Figs. 11-12)"))
         summary["tasks"][task] = {
             "mean_return": float(np.mean(replays[task]["returns"])),
             "mean_teams_per_step": float(replays[task].counts("visit").mean()),
@@ -166,7 +166,7 @@ def build_analysis(
         f"{decompose_task}: where each team ran over {episodes} test episodes",
     )
     sections.append(
-        _img(files["decomposition"], f"Task decomposition of {decompose_task} (Fig. 12)")
+        _img(files["decomposition"], f"Task decomposition of {decompose_task} (Fig. 10)")
     )
     if run_dir is not None:
         stats = hierarchy_statistics(run_dir)

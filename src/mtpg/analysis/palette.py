@@ -16,7 +16,7 @@ TASK_COLOURS: dict[str, str] = dict(
         strict=True,
     )
 )
-#: Colours of the three atomic discrete actions (Fig. 12 style decompositions).
+#: Colours of the three atomic discrete actions (Fig. 10 style decompositions).
 ACTION_COLOURS: tuple[str, ...] = ("#0072b2", "#e69f00", "#cc79a7")
 #: Colormap of continuous actions.
 CONTINUOUS_CMAP = "viridis"  # no grey anywhere: grey marks "passed on"

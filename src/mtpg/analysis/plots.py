@@ -61,7 +61,7 @@ def _task_axis(ax, tasks: tuple[str, ...]) -> None:
 
 
 def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
-    """Fig. 3: test return per task over generations, every run of one group.
+    """Fig. 4: test return per task over generations, every run of one group.
 
     Grey: the all-task champion of each run at each test point; black: the best run;
     dotted: the median over runs of the single-task champion of that task.
@@ -135,7 +135,7 @@ def _value_labels(ax, xs, values, fmt="{:.2f}") -> None:
 
 
 def normalised_vs_single(group: RunGroup, numbers: Numbers, path: Path) -> Path:
-    """Fig. 4: each run's all-task champion normalised by its own single-task champions."""
+    """Fig. 5: each run's all-task champion normalised by its own single-task champions."""
     plt = pyplot()
     runs = [numbers[r.path] for r in group.runs]
     tasks = group.runs[0].tasks
@@ -182,7 +182,7 @@ def _bars(ax, tasks, groups: dict[str, dict[str, float]]) -> None:
 
 
 def normalised_vs_reference(group: RunGroup, numbers: Numbers, path: Path) -> Path:
-    """Fig. 5: the best run's all-task and single-task champions against the reference best."""
+    """Fig. 6: the best run's all-task and single-task champions against the reference best."""
     plt = pyplot()
     best = best_of([numbers[r.path] for r in group.runs])
     tasks = best.run.tasks
@@ -208,7 +208,7 @@ def normalised_vs_reference(group: RunGroup, numbers: Numbers, path: Path) -> Pa
 
 
 def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
-    """Fig. 6: the best run's all-task champion of each experiment, side by side.
+    """Fig. 7: the best run's all-task champion of each experiment, side by side.
 
     Denominators: the single-task champions of the best run of the first group (the full
     algorithm when present), so every experiment is measured against the same scores.
@@ -239,7 +239,7 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
 
 
 def hierarchy(group: RunGroup, numbers: Numbers, path: Path) -> Path:
-    """Fig. 7: teams visited per decision by the champion of every task subset.
+    """Fig. 8: teams visited per decision by the champion of every task subset.
 
     One column per subset (ordered by size); points: minimum, median and maximum over runs
     at the final test point, as in the paper.

@@ -111,17 +111,17 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
     figures = [
         (
             "learning_curves.png",
-            "Learning curves (Fig. 3)",
+            "Learning curves (Fig. 4)",
             lambda p: plots.learning_curves(main, numbers, p),
         ),
         (
             "normalised_vs_single.png",
-            "Against single-task champions (Fig. 4)",
+            "Against single-task champions (Fig. 5)",
             lambda p: plots.normalised_vs_single(main, numbers, p),
         ),
         (
             "normalised_vs_reference.png",
-            "Against the reference best (Fig. 5)",
+            "Against the reference best (Fig. 6)",
             lambda p: plots.normalised_vs_reference(main, numbers, p),
         ),
     ]
@@ -129,14 +129,14 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
         figures.append(
             (
                 "ablations.png",
-                "Experiments and ablations (Fig. 6)",
+                "Experiments and ablations (Fig. 7)",
                 lambda p: plots.ablations(groups, numbers, p),
             )
         )
     figures += [
         (
             "hierarchy.png",
-            "Teams per decision by task subset (Fig. 7)",
+            "Teams per decision by task subset (Fig. 8)",
             lambda p: plots.hierarchy(main, numbers, p),
         ),
         (

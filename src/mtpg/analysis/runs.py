@@ -1,7 +1,7 @@
 """Loading finished runs, grouping them by configuration, and normalising scores.
 
 ``normalised = (score - random) / (best - random)``: 0 is random play; ``best`` is either
-a single-task champion (Figs. 4 and 6) or the reference best of the task (Fig. 5); see
+a single-task champion (Figs. 5 and 7) or the reference best of the task (Fig. 6); see
 :mod:`mtpg.analysis.numbers` for which champion every reported number comes from.
 
 Runs are grouped by configuration: two runs belong to one group when their configurations
@@ -206,5 +206,5 @@ def normalise_scores(scores: dict[str, float], best: dict[str, float]) -> dict[s
 
 
 def reference_best(tasks: tuple[str, ...]) -> dict[str, float]:
-    """The reference best score of each task (Fig. 5)."""
+    """The reference best score of each task (Fig. 6)."""
     return {t: REFERENCE[TASK_NAMES.index(t)].best for t in tasks}

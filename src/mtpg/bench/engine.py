@@ -228,11 +228,23 @@ def _same_result(a: BatchResult, b: BatchResult) -> bool:
     )
 
 
-def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, flags):
-    """Times the C port interleaved with the engine: C, engine, C, engine, ...
+def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, builds):
+    """Times each C build interleaved with the engine: C, engine, C', engine, C, ...
+
+    Every C run is paired with the one-thread engine run just after it, so each build's
+    ratio is a median of per-pair ratios, free of the drift of a shared machine.
+
+    Args:
+        work: The workload.
+        engine: The engine's outcomes, which every C build must equal.
+        repeats: Pairs per build.
+        say: Progress callback.
+        engine_run: Runs the engine once on one thread (a ``DriveResult``).
+        builds: Optimisation flag tuples, one C build each.
 
     Returns:
-        ``(c_cpu_seconds, engine_cpu_seconds)`` per repeat, or None without a compiler.
+        ``{flags: (c_cpu_seconds, engine_cpu_seconds)}`` per repeat, or None without a
+        compiler.
     """
     from mtpg.bench import c_port
 
@@ -240,19 +252,32 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, 
         say("no C compiler: the C port is not timed")
         return None
     with tempfile.TemporaryDirectory(prefix="mtpg-bench-") as tmp:
-        exe = c_port.build(Path(tmp), flags=flags)
-        say(f"C port compiled with {' '.join(flags)}")
         data = Path(tmp) / "workload.bin"
         c_port.write_input(work, data)
-        first = c_port.run_port(exe, data, len(work.job_roots))
-        c_port.check(engine, first.result)
-        say("C port: every job's return, steps, teams and instructions equal the engine's")
-        c_cpu, e_cpu = [], []
+        exes = {}
+        for k, flags in enumerate(builds):
+            folder = Path(tmp) / f"build{k}"
+            folder.mkdir()
+            exes[flags] = c_port.build(folder, flags=flags)
+            first = c_port.run_port(exes[flags], data, len(work.job_roots))
+            c_port.check(engine, first.result)
+            say(
+                f"C port ({' '.join(flags)}): every job's return, steps, teams and instructions"
+                " equal the engine's"
+            )
+        pairs: dict[tuple[str, ...], tuple[list[float], list[float]]] = {
+            flags: ([], []) for flags in builds
+        }
         for r in range(repeats):
-            c_cpu.append(c_port.run_port(exe, data, len(work.job_roots)).cpu_seconds)
-            e_cpu.append(engine_run().cpu_seconds)
-            say(f"  pair {r + 1}/{repeats}: C {c_cpu[-1]:.3f} s, engine {e_cpu[-1]:.3f} s CPU")
-    return c_cpu, e_cpu
+            for flags, exe in exes.items():
+                c_cpu, e_cpu = pairs[flags]
+                c_cpu.append(c_port.run_port(exe, data, len(work.job_roots)).cpu_seconds)
+                e_cpu.append(engine_run().cpu_seconds)
+                say(
+                    f"  pair {r + 1}/{repeats} ({' '.join(flags)}): C {c_cpu[-1]:.3f} s,"
+                    f" engine {e_cpu[-1]:.3f} s CPU"
+                )
+    return pairs
 
 
 def benchmark(
@@ -268,6 +293,7 @@ def benchmark(
     pytpg: bool = True,
     c: bool = False,
     c_flags: tuple[str, ...] | None = None,
+    c_beside: tuple[str, ...] | None = None,
     log=None,
 ) -> dict:
     """Runs the whole benchmark.
@@ -290,6 +316,8 @@ def benchmark(
             bit for bit against the engine and run interleaved with one-thread engine runs
             (process CPU time of both).
         c_flags: Optimisation flags of the C build (default ``c_port.C_FLAGS``).
+        c_beside: Flags of a second C build reported beside it (default
+            ``c_port.C_FLAGS_BESIDE``; an empty tuple for none).
         log: Called with progress lines (``None``: silent).
 
     Returns:
@@ -338,10 +366,12 @@ def benchmark(
     c_pairs = None
     if c:
         say("the same work in C (interleaved with one-thread engine runs) ...")
-        from mtpg.bench.c_port import C_FLAGS
+        from mtpg.bench.c_port import C_FLAGS, C_FLAGS_BESIDE
 
         c_flags = tuple(c_flags) if c_flags else C_FLAGS
-        c_pairs = _c_runs(work, first, repeats, say, lambda: drive(work, 1), c_flags)
+        c_beside = C_FLAGS_BESIDE if c_beside is None else tuple(c_beside)
+        builds = [c_flags] + ([c_beside] if c_beside and c_beside != c_flags else [])
+        c_pairs = _c_runs(work, first, repeats, say, lambda: drive(work, 1), builds)
     rate = decisions / seconds
     ref_rate = ref.decisions / ref.seconds if ref is not None and ref.seconds > 0 else None
     pt_rate = pt["decisions"] / pt["seconds"] if pt and pt["seconds"] > 0 else None
@@ -387,11 +417,17 @@ def benchmark(
         out["scaling"] = statistics.median(scaling)
         out["scaling_all"] = scaling
     if c_pairs is not None:
-        c_cpu, e_cpu = c_pairs
-        ratios = [cc / ee for cc, ee in zip(c_cpu, e_cpu, strict=True)]
-        out["c_decisions_per_s"] = decisions / statistics.median(c_cpu)
-        out["engine_cpu_decisions_per_s"] = decisions / statistics.median(e_cpu)
-        out["engine_vs_c"] = statistics.median(ratios)
-        out["engine_vs_c_all"] = ratios
-        out["c_flags"] = " ".join(c_flags)
+        for k, (flags, (c_cpu, e_cpu)) in enumerate(c_pairs.items()):
+            ratios = [cc / ee for cc, ee in zip(c_cpu, e_cpu, strict=True)]
+            figures = {
+                "c_decisions_per_s": decisions / statistics.median(c_cpu),
+                "engine_cpu_decisions_per_s": decisions / statistics.median(e_cpu),
+                "engine_vs_c": statistics.median(ratios),
+                "engine_vs_c_all": ratios,
+                "c_flags": " ".join(flags),
+            }
+            if k == 0:
+                out.update(figures)
+            else:
+                out["c_beside"] = figures
     return out

@@ -56,8 +56,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     eng.add_argument(
         "--c-flags",
+        default="-O3 -march=native",
+        help="optimisation flags of the C build ('-O3 -march=native'; fast-math refused)",
+    )
+    eng.add_argument(
+        "--c-beside",
         default="-O2 -march=native",
-        help="optimisation flags of the C build ('-O2 -march=native'; fast-math refused)",
+        help="flags of a second C build reported beside it ('-O2 -march=native'; '' for none)",
     )
     eng.set_defaults(func=run)
     bench.set_defaults(func=lambda _args: _help(bench))
@@ -99,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
         pytpg=not args.no_pytpg,
         c=args.c,
         c_flags=tuple(args.c_flags.split()),
+        c_beside=tuple(args.c_beside.split()),
         log=log,
     )
     m = r["machine"]
@@ -144,6 +150,13 @@ def run(args: argparse.Namespace) -> int:
             f" for bit); engine {_fmt(r['engine_cpu_decisions_per_s'])} on 1 thread:"
             f" {r['engine_vs_c']:.3f} of C (median of {r['repeats']} interleaved pairs, CPU time;"
             f" C built with {r['c_flags']})",
+        )
+    if r.get("c_beside"):
+        b = r["c_beside"]
+        lines.insert(
+            -1,
+            f"                C built with {b['c_flags']}: {_fmt(b['c_decisions_per_s'])}"
+            f" decisions/s; engine {b['engine_vs_c']:.3f} of it",
         )
     print("\n".join(lines))
     sys.stdout.flush()

@@ -1,6 +1,6 @@
 """Reference scores of the six tasks, the measurements behind them, and normalisation.
 
-``normalise(task, score) = (score - random) / (best - random)`` (paper, Figs. 4-6): 0 is
+``normalise(task, score) = (score - random) / (best - random)`` (paper, Figs. 5-7): 0 is
 random play, 1 the reference best.
 
 Conventions (used by the stored figures and by the re-measuring functions):
@@ -57,7 +57,7 @@ class Reference(NamedTuple):
     Attributes:
         random: Mean score of the random agent (see the module docstring).
         random_std: Standard deviation of that score.
-        best: Reference best score (Fig. 5 normalisation).
+        best: Reference best score (Fig. 6 normalisation).
         solved: Registered solved threshold, or NaN when there is none.
         source: Where ``best`` comes from.
     """
@@ -168,7 +168,7 @@ def normalise(
         task: The task id.
         score: A score, or an array of scores.
         best: The best score to normalise against (e.g. the best single-task agent of the
-            run, Figs. 4 and 6); the reference best (Fig. 5) when None.
+            run, Figs. 5 and 7); the reference best (Fig. 6) when None.
 
     Returns:
         0 for random play, 1 for ``best``; same shape as ``score``.

@@ -1,0 +1,87 @@
+"""``tools/grow_results.py``: runs grown in slices equal uninterrupted runs, and are committed."""
+
+import csv
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+from stopruns import mtpg, without_timing
+from tinyruns import tiny_args
+
+TOOL = Path(__file__).parents[2] / "tools" / "grow_results.py"
+SETTINGS = tiny_args(
+    "CartPole,MountainCar",
+    root_size=20,
+    n_elite=3,
+    evaluation__test_interval=2,
+    evaluation__test_episodes=3,
+    checkpoint_interval=3,
+)
+GENERATIONS = 24
+
+
+def _tool():
+    spec = importlib.util.spec_from_file_location("grow_results", TOOL)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["grow_results"] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def _git(repo, *args):
+    return subprocess.run(["git", *args], cwd=repo, capture_output=True, text=True, check=True)
+
+
+def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypatch):
+    for key in ("AUTHOR", "COMMITTER"):
+        monkeypatch.setenv(f"GIT_{key}_NAME", "mtpg tests")
+        monkeypatch.setenv(f"GIT_{key}_EMAIL", "tests@mtpg.invalid")
+    repo = tmp_path / "repo"
+    (repo / "results").mkdir(parents=True)
+    _git(repo, "init", "-q")
+    _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
+    tool = _tool()
+    monkeypatch.setattr(
+        tool, "PLAN", (("TPG-seed3", 3, None), ("TPG-NoMemory-seed3", 3, "no-memory"))
+    )
+    monkeypatch.setattr(tool, "KEEP_TESTS_EVERY", 8)
+    argv = ["--budget", "5", "--unchecked", "--results", str(repo / "results")]
+    argv += [f"--train-arg={a}" for a in SETTINGS]
+    # two sittings, the second one in slices of about 2 seconds
+    assert tool.main([*argv, "--generations", "10"]) == 0
+    assert tool.main([*argv, "--generations", str(GENERATIONS), "--slice", "0.04"]) == 0
+
+    for name, seed, flag in tool.PLAN:
+        grown = repo / "results" / "runs" / name
+        ref = tmp_path / name
+        extra = [f"--{flag}"] if flag else []
+        args = ["train", "--preset", "paper", "--seed", str(seed), *extra, *SETTINGS]
+        assert mtpg(*args, "--generations", str(GENERATIONS), "--out", str(ref)).returncode == 0
+        for table in ("metrics.csv", "tests.csv"):
+            assert without_timing((grown / table).read_text()) == without_timing(
+                (ref / table).read_text()
+            )
+        ckpts = sorted(p.name for p in (grown / "checkpoints").iterdir())
+        assert ckpts == [f"gen-{GENERATIONS:06d}.json.gz"]
+        final = ckpts[0]
+        assert (grown / "checkpoints" / final).read_bytes() == (
+            ref / "checkpoints" / final
+        ).read_bytes()
+        kept = sorted(p.name for p in (grown / "tests").iterdir())
+        assert kept == ["gen-000008", "gen-000016", "gen-000024"]
+        for folder in kept:
+            for graph in (ref / "tests" / folder).iterdir():
+                assert (grown / "tests" / folder / graph.name).read_bytes() == graph.read_bytes()
+        rows = list(csv.DictReader(open(grown / "provenance.csv")))
+        assert len(rows) >= 2 and rows[0]["from_generation"] == "0"
+        assert rows[-1]["to_generation"] == str(GENERATIONS)
+        for a, b in zip(rows, rows[1:], strict=False):
+            assert a["to_generation"] == b["from_generation"]
+        assert {r["mtpg_commit"] for r in rows} == {"unchecked"}
+
+    assert _git(repo, "status", "--porcelain").stdout == ""
+    log = _git(repo, "log", "--format=%s").stdout.splitlines()
+    assert len(log) >= 2 and log[0].startswith("results: grow")
+    tracked = _git(repo, "ls-files").stdout
+    assert ".lock" not in tracked and ".log" not in tracked

@@ -1,0 +1,81 @@
+"""``tools/results_readme.py``: the results page and its figures, from run directories alone."""
+
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+from stopruns import mtpg
+from tinyruns import tiny_args
+
+sys.path.insert(0, str(Path(__file__).parents[2] / "tools"))
+import results_readme  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("results")
+    settings = tiny_args(
+        "CartPole,MountainCar", root_size=16, n_elite=2, evaluation__test_interval=2
+    )
+    for name, seed, flag in (
+        ("TPG-seed1", 1, []),
+        ("TPG-seed2", 2, []),
+        ("TPG-NoMemory-seed1", 1, ["--no-memory"]),
+    ):
+        done = mtpg(
+            "train",
+            "--preset",
+            "paper",
+            "--seed",
+            str(seed),
+            *flag,
+            *settings,
+            "--set",
+            "evaluation.test_episodes=5",
+            "--generations",
+            "4",
+            "--out",
+            str(folder / "runs" / name),
+        )
+        assert done.returncode == 0, done.stderr
+    return folder
+
+
+def test_the_page_links_every_figure_it_draws_and_names_every_run(results):
+    readme = results_readme.build(results, analyze=True)
+    text = readme.read_text()
+    links = re.findall(r"!\[[^]]*\]\(([^)]+)\)", text)
+    assert any(link.startswith("figures/") for link in links)
+    assert any(link.startswith("analysis/") for link in links)
+    for link in links:
+        assert (results / link).is_file(), link
+    for name in ("TPG-seed1", "TPG-seed2", "TPG-NoMemory-seed1"):
+        assert f"| {name} |" in text
+    assert "**In progress**" in text  # 4 of 1,000 generations
+    assert not (results / "figures" / "index.html").exists()
+
+
+def test_the_page_quotes_the_numbers_of_the_report(results):
+    from mtpg.analysis.numbers import run_numbers
+    from mtpg.analysis.runs import load_run
+
+    text = results_readme.build(results, analyze=False).read_text()
+    for name in ("TPG-seed1", "TPG-NoMemory-seed1"):
+        n = run_numbers(load_run(results / "runs" / name))
+        cells = [f"{n.normalised[t]:.2f}" for t in n.run.tasks]
+        assert f"| {name} | {n.generation} | " + " | ".join(cells) + " |" in text
+
+
+def test_the_page_gives_each_champion_test_return_with_its_interval(results):
+    from mtpg.analysis.numbers import run_numbers
+    from mtpg.analysis.runs import load_run
+
+    text = results_readme.build(results, analyze=False).read_text()
+    n = run_numbers(load_run(results / "runs" / "TPG-seed2"))
+    row = next(
+        line for line in text.splitlines() if line.startswith("| TPG-seed2 |") and "±" in line
+    )
+    means = [float(cell.split("±")[0]) for cell in row.split("|")[3:-1]]
+    assert means == [float(f"{n.test[t]:.4g}") for t in n.run.tasks]

@@ -1,0 +1,298 @@
+"""Grow the committed runs of ``results/`` for a wall-clock budget, then commit them.
+
+The paper's experiment (five seeds of the ``paper`` preset and one seed of each ablation,
+1,000 generations each) takes longer than one sitting on a small machine, so its runs
+grow over many sittings, machines and commits. Each call of this script::
+
+    .venv/bin/python tools/grow_results.py --budget 150          # minutes
+
+continues the unfinished runs of :data:`PLAN` in order, ``--parallel`` at a time, each an
+ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun). Every
+``--slice`` minutes, and when the budget is spent or the script is stopped (SIGTERM,
+SIGINT, SIGHUP), the runs are sent SIGTERM, so each commits the generation under way and
+ends; then every run touched is tidied for the repository and committed with git:
+
+* only its newest checkpoint is kept (``mtpg train --resume`` needs nothing else);
+* of the test-point graph folders ``tests/gen-NNNNNN/`` only every
+  :data:`KEEP_TESTS_EVERY`-th generation and the newest are kept (the report and the
+  analyses read the newest; ``tests.csv`` keeps every test point's scores);
+* a row is appended to its ``provenance.csv``: generations from/to, the mtpg commit that
+  ran them, start time, wall-clock and CPU seconds, workers, processor and host.
+
+The mtpg that runs is the one installed for ``--python`` (default: this interpreter). It
+must be a clean git checkout whose commit is in this repository's history, so that the
+commit recorded reproduces the generations exactly; ``tests/evolve/test_paper_pin.py``
+guards that later commits keep resuming them exactly.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import platform
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+#: The experiment: (run directory name, seed, ablation flag or None).
+PLAN: tuple[tuple[str, int, str | None], ...] = (
+    *((f"TPG-seed{s}", s, None) for s in range(1, 6)),
+    ("TPG-NoXover-seed1", 1, "no-crossover"),
+    ("TPG-NoMemory-seed1", 1, "no-memory"),
+    ("TPG-NoHierarchy-seed1", 1, "no-hierarchy"),
+)
+#: Test-point folders kept: generations divisible by this, and the newest.
+KEEP_TESTS_EVERY = 100
+#: Seconds a run is given to commit after SIGTERM before it is told to stop at once.
+STOP_GRACE_S = 300
+PROVENANCE = "provenance.csv"
+PROVENANCE_COLUMNS = (
+    "from_generation",
+    "to_generation",
+    "mtpg_commit",
+    "started_utc",
+    "wall_s",
+    "cpu_s",
+    "workers",
+    "processor",
+    "host",
+)
+
+
+def sh(*cmd: str, cwd: Path | None = None, check: bool = True) -> str:
+    """Runs a command and returns its standard output, stripped."""
+    done = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    if check and done.returncode != 0:
+        raise SystemExit(f"grow_results: {' '.join(cmd)}: {done.stderr.strip()}")
+    return done.stdout.strip()
+
+
+def processor() -> str:
+    """The processor's model name (``/proc/cpuinfo``), or what ``platform`` says."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def source_commit(python: str, repo: Path) -> str:
+    """The commit of the mtpg that ``python`` imports; refuses a dirty or foreign tree."""
+    init = sh(python, "-c", "import mtpg; print(mtpg.__file__)")
+    top = Path(sh("git", "rev-parse", "--show-toplevel", cwd=Path(init).parent))
+    dirty = sh("git", "status", "--porcelain", "--untracked-files=no", "--", "src", cwd=top)
+    if dirty:
+        raise SystemExit(f"grow_results: {top} has uncommitted changes in src/:\n{dirty}")
+    commit = sh("git", "rev-parse", "HEAD", cwd=top)
+    known = subprocess.run(["git", "merge-base", "--is-ancestor", commit, "HEAD"], cwd=repo)
+    if known.returncode != 0:
+        raise SystemExit(f"grow_results: mtpg commit {commit[:12]} is not in {repo}'s history")
+    return commit
+
+
+def last_generation(run: Path) -> int:
+    """Generation of the newest checkpoint of a run (0 when it has none)."""
+    found = [int(p.name[4:10]) for p in (run / "checkpoints").glob("gen-??????.json.gz")]
+    return max(found, default=0)
+
+
+@dataclass
+class Job:
+    """One ``mtpg train`` process growing one run."""
+
+    name: str
+    path: Path
+    proc: subprocess.Popen
+    start_gen: int
+    started: float = field(default_factory=time.time)
+    status: int | None = None
+    cpu_s: float = 0.0
+
+    def poll(self) -> bool:
+        """True once the process has ended (its status and CPU time then recorded)."""
+        if self.status is None:
+            pid, status, usage = os.wait4(self.proc.pid, os.WNOHANG)
+            if pid:
+                self.status = os.waitstatus_to_exitcode(status)
+                self.proc.returncode = self.status
+                self.cpu_s = usage.ru_utime + usage.ru_stime
+        return self.status is not None
+
+
+def start(name: str, seed: int, ablation: str | None, args: argparse.Namespace) -> Job:
+    """Starts (or resumes) one run of the plan."""
+    path = args.results / "runs" / name
+    common = ["--generations", str(args.generations), "--workers", str(args.workers), "--quiet"]
+    if (path / "config.toml").is_file():
+        cmd = ["train", "--resume", str(path), *common]
+    else:
+        flag = [f"--{ablation}"] if ablation else []
+        cmd = ["train", "--preset", "paper", "--seed", str(seed), *flag, *common]
+        cmd += [*args.train_arg, "--out", str(path)]
+    log = open(args.results / "runs" / f"{name}.log", "a")  # noqa: SIM115 - the child's
+    proc = subprocess.Popen(
+        [args.python, "-m", "mtpg", *cmd],
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        start_new_session=True,
+    )
+    return Job(name, path, proc, last_generation(path))
+
+
+def tidy(run: Path) -> None:
+    """Keeps the newest checkpoint and every ``KEEP_TESTS_EVERY``-th test folder."""
+    ckpts = sorted((run / "checkpoints").glob("gen-*"))
+    for extra in ckpts[:-1]:
+        extra.unlink()
+    newest = last_generation(run)
+    folders = sorted((run / "tests").glob("gen-??????"))
+    kept = [f for f in folders if int(f.name[4:]) <= newest]
+    for f in kept[:-1]:
+        if int(f.name[4:]) % KEEP_TESTS_EVERY:
+            shutil.rmtree(f)
+
+
+def record(job: Job, commit: str, workers: int) -> None:
+    """Appends the job's row to its run's ``provenance.csv``."""
+    end = last_generation(job.path)
+    if end == job.start_gen:
+        return
+    path = job.path / PROVENANCE
+    new = not path.exists()
+    with open(path, "a", newline="") as f:
+        w = csv.writer(f)
+        if new:
+            w.writerow(PROVENANCE_COLUMNS)
+        started = datetime.fromtimestamp(job.started, UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+        wall = time.time() - job.started
+        host = platform.node()
+        w.writerow(
+            [
+                job.start_gen,
+                end,
+                commit,
+                started,
+                f"{wall:.0f}",
+                f"{job.cpu_s:.0f}",
+                workers,
+                processor(),
+                host,
+            ]
+        )
+
+
+def commit_results(repo: Path, results: Path, jobs: list[Job]) -> None:
+    """Commits ``results/runs`` (and nothing else that may be staged)."""
+    moved = [f"{j.name} {j.start_gen}->{last_generation(j.path)}" for j in jobs]
+    runs = str((results / "runs").relative_to(repo))
+    # run logs and lock files stay out, whatever the repository's ignore rules
+    sh("git", "add", "-A", "--", runs, f":!{runs}/*.log", f":!{runs}/*/.lock", cwd=repo)
+    if not sh("git", "status", "--porcelain", "--", runs, cwd=repo):
+        return
+    msg = "results: grow " + ", ".join(moved) + " (generations committed by the runs)"
+    done = subprocess.run(["git", "commit", "-q", "-m", msg, "--", runs], cwd=repo)
+    print(("committed: " if done.returncode == 0 else "commit FAILED: ") + msg, flush=True)
+
+
+def stop_all(jobs: list[Job]) -> None:
+    """SIGTERM to every running job; waits for it to commit (SIGTERM again after a grace)."""
+    for j in jobs:
+        if not j.poll():
+            j.proc.send_signal(signal.SIGTERM)
+    deadline = time.time() + STOP_GRACE_S
+    while not all(j.poll() for j in jobs):
+        if time.time() > deadline:
+            for j in jobs:
+                if not j.poll():
+                    j.proc.send_signal(signal.SIGTERM)
+            deadline = float("inf")
+        time.sleep(0.5)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the script (see the module docstring)."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--budget", type=float, required=True, help="minutes of wall-clock time")
+    p.add_argument("--slice", type=float, default=40, help="minutes between commits (40)")
+    p.add_argument("--parallel", type=int, default=2, help="runs at a time (2)")
+    p.add_argument("--workers", type=int, default=1, help="threads per run (1)")
+    p.add_argument("--generations", type=int, default=1000, help="target (1000)")
+    p.add_argument("--python", default=sys.executable, help="interpreter whose mtpg runs")
+    p.add_argument("--results", type=Path, default=Path("results"), help="folder (results)")
+    p.add_argument("--no-commit", action="store_true", help="tidy and record, commit nothing")
+    p.add_argument(
+        "--train-arg",
+        action="append",
+        default=[],
+        metavar="ARG",
+        help="extra mtpg train argument for runs begun now (tests and trials only)",
+    )
+    p.add_argument(
+        "--unchecked",
+        action="store_true",
+        help="skip the clean-checkout checks (trials only; provenance then says so)",
+    )
+    args = p.parse_args(argv)
+    args.results = args.results.resolve()
+    repo = Path(sh("git", "rev-parse", "--show-toplevel", cwd=args.results))
+    commit = "unchecked" if args.unchecked else source_commit(args.python, repo)
+    (args.results / "runs").mkdir(parents=True, exist_ok=True)
+    ignore = args.results / "runs" / ".gitignore"
+    if not ignore.exists():
+        ignore.write_text(
+            "# written by tools/grow_results.py: run logs and run locks\n*.log\n*/.lock\n"
+        )
+    stop: list[int] = []
+    for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
+        signal.signal(sig, lambda s, _f: stop.append(s))
+    end = time.time() + 60 * args.budget
+    failed: set[str] = set()
+
+    def unfinished() -> list[tuple[str, int, str | None]]:
+        runs = args.results / "runs"
+        return [
+            r
+            for r in PLAN
+            if r[0] not in failed and last_generation(runs / r[0]) < args.generations
+        ]
+
+    print(f"mtpg {commit[:12]}; unfinished: {', '.join(r[0] for r in unfinished()) or 'none'}")
+    while unfinished() and not stop and time.time() < end:
+        slice_end, todo, jobs, running = (
+            min(end, time.time() + 60 * args.slice),
+            unfinished(),
+            [],
+            [],
+        )
+        while (todo or running) and not stop and time.time() < slice_end:
+            while todo and len(running) < args.parallel:
+                job = start(*todo.pop(0), args)
+                print(f"{job.name}: generation {job.start_gen} -> {args.generations}", flush=True)
+                jobs.append(job)
+                running.append(job)
+            for job in [j for j in running if j.poll()]:
+                running.remove(job)
+                print(f"{job.name}: ended ({job.status}) at {last_generation(job.path)}")
+            time.sleep(1)
+        stop_all(running)
+        for job in jobs:
+            tidy(job.path)
+            record(job, commit, args.workers)
+            if last_generation(job.path) < args.generations and job.status not in (0, 143):
+                print(f"{job.name}: failed ({job.status}); see {job.path}.log", flush=True)
+                failed.add(job.name)
+        if not args.no_commit:
+            commit_results(repo, args.results, jobs)
+    return 128 + stop[0] if stop else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,263 @@
+"""Regenerate ``results/README.md`` and its figures from the committed runs.
+
+One command, from the repository root with the project's environment::
+
+    .venv/bin/python tools/results_readme.py
+
+It reads ``results/runs/*`` (see ``tools/grow_results.py``), draws the section-5 figures
+with ``mtpg report`` into ``results/figures/``, the section-6 figures of the best run's
+all-task champion with ``mtpg analyze`` into ``results/analysis/``, and writes the README:
+status and cost of every run, the tables behind the figures, and the comparison with the
+paper task by task. Every number in the text is computed here from the runs' files, by the
+same library functions the report uses (:mod:`mtpg.analysis.numbers`,
+:mod:`mtpg.analysis.stats`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parent))
+from grow_results import KEEP_TESTS_EVERY  # noqa: E402
+from results_text import (  # noqa: E402 - the tool's own helper module beside it
+    PAPER,
+    ablation_rows,
+    compare_table,
+    cost_rows,
+    hierarchy_rows,
+    markdown_table,
+    rescore_rows,
+    status_rows,
+)
+
+TARGET = 1000
+GROWING = [
+    "## Growing the runs",
+    "",
+    "Each run directory holds `config.toml`, `metrics.csv`, `tests.csv`, `champions/`, its "
+    f"newest checkpoint, the test-point graphs of every {KEEP_TESTS_EVERY}th generation and "
+    "of the latest "
+    "test point (`tests/gen-NNNNNN/`; `tests.csv` has the scores of every test point), and "
+    "`provenance.csv`: which mtpg commit ran which generations, when, for how long, on "
+    "which processor. To continue them, from a clone of the repository:",
+    "",
+    "```sh",
+    "python3 -m venv .venv && .venv/bin/pip install -e .",
+    ".venv/bin/python tools/grow_results.py --budget 150   # minutes; commits every 40",
+    ".venv/bin/python tools/results_readme.py              # this page and its figures",
+    "git push",
+    "```",
+    "",
+    "`grow_results.py` continues the unfinished runs in order, two at a time with one "
+    "thread each, stops them with SIGTERM at a generation boundary every `--slice` minutes "
+    "and when the budget is spent (or when it is itself stopped), keeps the newest "
+    "checkpoint and commits `results/runs`. It refuses to run an mtpg whose `src/` has "
+    "uncommitted changes or whose commit is not in the repository's history, so the "
+    "commit it records reproduces the generations. A single run can also be continued by "
+    "hand: `mtpg train --resume results/runs/TPG-seed3 --workers 2`.",
+    "",
+    "Resuming with a later commit is exact because `tests/evolve/test_paper_pin.py` pins the "
+    "`paper` preset: a fresh three-generation run and a stored checkpoint resumed to "
+    "generation 6 must repeat stored metrics, tests and run-state digests. A change that "
+    "fails it alters the `paper` preset: it must say so, and the runs here restart from "
+    "generation 0 with the new commit recorded.",
+    "",
+]
+
+
+def _runs(results: Path) -> list[Path]:
+    return sorted(
+        (p for p in (results / "runs").iterdir() if (p / "tests.csv").is_file()),
+        key=lambda p: (not p.name.startswith("TPG-seed"), p.name),
+    )
+
+
+def _fig(name: str, caption: str) -> str:
+    return f"![{caption}](figures/{name})\n\n*{caption}*\n"
+
+
+def build(results: Path, analyze: bool = True) -> Path:
+    """Writes the figures and ``README.md`` of ``results``; returns the README's path."""
+    from mtpg.analysis.numbers import BEST_RUN_RULE, CHAMPION_RULE, best_of, run_numbers
+    from mtpg.analysis.plots_stats import STATS_NOTE, group_estimates
+    from mtpg.analysis.report import build_report
+    from mtpg.analysis.runs import group_runs, load_run
+
+    paths = _runs(results)
+    runs = [load_run(p) for p in paths]
+    figures = results / "figures"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        build_report(paths, figures)
+    (figures / "index.html").unlink(missing_ok=True)  # the PNGs are committed instead
+    groups, _ = group_runs(runs)
+    numbers = {r.path: run_numbers(r) for r in runs}
+    tasks = runs[0].tasks
+    tpg = groups[0]
+    best = best_of([numbers[r.path] for r in tpg.runs])
+    per_task, overall = group_estimates(tpg, numbers)
+    best_single = {t: max(numbers[r.path].single[t] for r in tpg.runs) for t in tasks}
+
+    lines = [
+        "# The paper's experiment, reproduced",
+        "",
+        "Five runs of the `paper` preset (seeds 1 to 5) and one run of each ablation of "
+        "section 5.2 (seed 1), each grown to 1,000 generations over several sittings with "
+        "`tools/grow_results.py` and committed with its last checkpoint, so that "
+        "`mtpg train --resume results/runs/RUN` continues any of them exactly. This page "
+        "and its figures are written by `.venv/bin/python tools/results_readme.py` from "
+        "the committed files alone.",
+        "",
+        "## Status",
+        "",
+    ]
+    done = all(r.final_generation >= TARGET for r in runs)
+    if not done:
+        lines += [
+            "**In progress**: not every run has reached generation 1,000, so every figure "
+            "and number below is of the runs' latest test point (named in each table), "
+            "not of the paper's 1,000 generations.",
+            "",
+        ]
+    lines += markdown_table(*status_rows(runs, TARGET)) + [""]
+    lines += [
+        "## Section 5: test scores",
+        "",
+        f"Champions: {CHAMPION_RULE}. {BEST_RUN_RULE}. Test score: mean return over "
+        f"{runs[0].test_episodes} held-out episodes per task (never used for any choice). "
+        "Normalised: 0 = random play, 1 = the reference best (`mtpg envs`) or, for "
+        "*vs single*, the best single-task champion of all TPG runs at its final test "
+        "point, as in the paper's Fig. 5.",
+        "",
+        f"Best TPG run: **{best.run.name}** (generation {best.generation}, all-task "
+        f"champion of {best.graph_teams} teams).",
+        "",
+    ]
+    lines += compare_table(best, best_single, tasks)
+    lines += [
+        "",
+        "Every run's all-task champion, normalised against the reference best, and the "
+        f"interquartile mean across the {len(tpg.runs)} TPG seeds with its 95% confidence "
+        f"interval ({STATS_NOTE})",
+        "",
+    ]
+    head = ["run", "generation", *tasks]
+    rows = [
+        [n.run.name, str(n.generation), *(f"{n.normalised[t]:.2f}" for t in tasks)]
+        for n in (numbers[r.path] for g in groups for r in g.runs)
+    ]
+    rows.append(["IQM over TPG seeds", "", *(e.text(2) for e in per_task)])
+    lines += markdown_table(head, rows)
+    lines += ["", f"IQM over TPG seeds and all tasks: {overall.text(2)}.", ""]
+    lines += [
+        "Every run's all-task champion: mean test return ± the half-width of its 95% "
+        f"confidence interval (1.96 std / sqrt(n), n = {runs[0].test_episodes} test "
+        "episodes, the scores of `tests.csv`), and in brackets the same graph re-scored on "
+        f"{runs[0].test_episodes} other held-out episodes (seed offset "
+        "500,000: `mtpg evaluate results/runs/RUN --seed 500000`). Two means over "
+        "independent blocks of episodes differ by less than 1.41 times the half-width "
+        "about 95% of the time.",
+        "",
+        *markdown_table(*rescore_rows(runs)),
+        "",
+    ]
+    vs_single_rows = [
+        [n.run.name, *(f"{x:.2f}" for x in _vs(n.test, best_single, tasks))]
+        for n in (numbers[r.path] for g in groups for r in g.runs)
+    ]
+    at_06 = sum(
+        all(v >= 0.6 for v in _vs(numbers[r.path].test, best_single, tasks)) for r in tpg.runs
+    )
+    lines += [
+        "Every run's all-task champion against the best single-task champion (Fig. 5):",
+        "",
+        *markdown_table(["run", *tasks], vs_single_rows),
+        "",
+        f"TPG runs whose all-task champion reaches 0.6 of the best single-task champion in "
+        f"all six tasks: **{at_06} of {len(tpg.runs)}** (paper: {PAPER['runs_at_06']}).",
+        "",
+    ]
+    lines += [
+        "The best run of each experiment against the best single-task champion of the TPG "
+        "runs (Fig. 7):",
+        "",
+        *markdown_table(*ablation_rows(groups, numbers, best_single, tasks)),
+        "",
+    ]
+    for name, caption in (
+        ("learning_curves.png", "Fig. 4: learning curves (test return at every test point)"),
+        ("normalised_vs_single.png", "Fig. 5: against single-task champions"),
+        ("normalised_vs_reference.png", "Fig. 6: against the reference best"),
+        ("ablations.png", "Fig. 7: the ablations beside full TPG"),
+        ("hierarchy.png", "Fig. 8: teams per decision by task subset"),
+        ("aggregate.png", "Across seeds: IQM with 95% bootstrap confidence intervals"),
+        ("performance_profile.png", "Across seeds: performance profile"),
+    ):
+        if (figures / name).is_file():
+            lines.append(_fig(name, caption))
+    lines += ["## Fig. 8: teams per decision by subset size", ""]
+    lines += markdown_table(*hierarchy_rows(tpg.runs)) + [""]
+    if analyze:
+        out = results / "analysis"
+        subprocess.run(
+            [sys.executable, "-m", "mtpg", "analyze", str(best.run.path), "--out", str(out)],
+            check=True,
+            capture_output=True,
+        )
+        (out / "index.html").unlink(missing_ok=True)
+    pngs = sorted((results / "analysis").glob("*.png")) if (results / "analysis").is_dir() else []
+    if pngs:
+        lines += [
+            "## Section 6: inside the best champion (Figs. 9-12)",
+            "",
+            f"`mtpg analyze {best.run.path.relative_to(results.parent)}`: the all-task "
+            f"champion of {best.run.name} at generation {best.generation}, replayed on 100 "
+            "test episodes per task.",
+            "",
+        ]
+        lines += [f"![{p.stem}](analysis/{p.name})\n" for p in pngs]
+    lines += ["## Cost", ""]
+    lines += [
+        "Wall-clock hours: the sum of `metrics.csv`'s `t_total` (every generation, test "
+        "points included). CPU hours: from `provenance.csv` (the process's user and system "
+        "time per sitting; sittings recorded without it are left out and the generations "
+        "covered are named). Each run ran with `--workers 1`, two runs at a time on a "
+        "2-core machine, while other work shared it, so these are upper bounds of what a "
+        "quiet machine needs (the processor is in each run's `provenance.csv`).",
+        "",
+    ]
+    lines += markdown_table(*cost_rows(runs)) + [""]
+    lines += GROWING
+    if caught:
+        lines += [f"Report warning: {w.message}" for w in caught] + [""]
+    readme = results / "README.md"
+    readme.write_text("\n".join(lines).rstrip() + "\n")
+    return readme
+
+
+def _vs(test: dict[str, float], best: dict[str, float], tasks) -> list[float]:
+    from mtpg.analysis.runs import normalise_scores
+
+    v = normalise_scores(test, best)
+    return [v[t] for t in tasks]
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the command (see the module docstring)."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--results", type=Path, default=Path("results"), help="folder (results)")
+    p.add_argument("--no-analyze", action="store_true", help="skip the section-6 figures")
+    args = p.parse_args(argv)
+    print(build(args.results, analyze=not args.no_analyze))
+    return 0
+
+
+if __name__ == "__main__":
+    np.seterr(all="ignore")
+    sys.exit(main())

@@ -1,0 +1,224 @@
+"""Tables of ``results/README.md`` (used by ``tools/results_readme.py``).
+
+Each function turns the committed files of the runs (``metrics.csv``, ``tests.csv``,
+``provenance.csv``, the checkpoint names) into a header and rows of strings; nothing here
+is typed in by hand but :data:`PAPER`, the paper's own figures (section 5).
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+#: What the paper reports (section 5, Figs. 5-8), in its own words.
+PAPER = {
+    "best_vs_single": 0.9,
+    "runs_at_06": "5 of 10",
+    "vs_reference": "at least 0.9 in 4 of 6 tasks, about 0.8 and 0.75 in the other two",
+    "TPG-NoXover": "at least 0.8 in every task",
+    "TPG-NoMemory": "well below 0.5 in every task",
+    "TPG-NoHierarchy": "good only in MountainCarContinuous",
+}
+#: Within this of the paper's figure counts as level.
+LEVEL = 0.05
+#: Generations at which the cost is quoted.
+COST_AT = (1, 250, 500, 1000)
+
+
+def markdown_table(head: list[str], rows: list[list[str]]) -> list[str]:
+    """A GitHub-flavoured Markdown table, one line per row."""
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    return out + ["| " + " | ".join(r) + " |" for r in rows]
+
+
+def checkpoint_generation(run: Path) -> int:
+    """Generation of the newest checkpoint of a run directory."""
+    names = [p.name for p in (Path(run) / "checkpoints").glob("gen-??????.json.gz")]
+    return max((int(n[4:10]) for n in names), default=0)
+
+
+def provenance(run: Path) -> list[dict[str, str]]:
+    """Rows of a run's ``provenance.csv`` (empty when there is none)."""
+    path = Path(run) / "provenance.csv"
+    return list(csv.DictReader(open(path))) if path.is_file() else []
+
+
+def metrics(run: Path) -> dict[int, dict[str, str]]:
+    """``metrics.csv`` rows by generation, up to the newest checkpoint."""
+    last = checkpoint_generation(run)
+    rows = csv.DictReader(open(Path(run) / "metrics.csv"))
+    return {int(r["generation"]): r for r in rows if int(r["generation"]) <= last}
+
+
+def status_rows(runs, target: int) -> tuple[list[str], list[list[str]]]:
+    """Run, experiment, seed, generations committed, latest test point, mtpg commits."""
+    head = ["run", "experiment", "seed", "generations", "latest test point", "mtpg commits"]
+    rows = []
+    for r in runs:
+        gen = checkpoint_generation(r.path)
+        commits = sorted({p["mtpg_commit"][:10] for p in provenance(r.path)})
+        state = f"{gen} of {target}" + ("" if gen >= target else " (growing)")
+        rows.append(
+            [
+                r.name,
+                r.label,
+                str(r.config.seed),
+                state,
+                str(r.final_generation),
+                ", ".join(commits),
+            ]
+        )
+    return head, rows
+
+
+def cost_rows(runs) -> tuple[list[str], list[list[str]]]:
+    """Wall-clock and CPU hours per run; s/gen, instructions and teams per decision at COST_AT."""
+    head = ["run", "wall h", "CPU h"] + [f"gen {g}: s/gen, instr/dec, teams/dec" for g in COST_AT]
+    rows = []
+    for r in runs:
+        m = metrics(r.path)
+        wall = sum(float(x["t_total"]) for x in m.values()) / 3600
+        prov = provenance(r.path)
+        cpu = sum(float(p["cpu_s"]) for p in prov if p["cpu_s"]) / 3600
+        measured = sum(
+            int(p["to_generation"]) - int(p["from_generation"]) for p in prov if p["cpu_s"]
+        )
+        cpu_text = f"{cpu:.2f} ({measured} gens)" if measured < len(m) else f"{cpu:.2f}"
+        cells = []
+        for g in COST_AT:
+            x = m.get(g)
+            cells.append(
+                "not yet"
+                if x is None
+                else f"{float(x['t_total']):.1f}, {float(x['instructions_per_decision']):.0f}, "
+                f"{float(x['teams_per_decision']):.2f}"
+            )
+        rows.append([r.name, f"{wall:.2f}", cpu_text, *cells])
+    return head, rows
+
+
+def hierarchy_rows(runs) -> tuple[list[str], list[list[str]]]:
+    """Teams per decision of each subset's champion at the final test point, by subset size."""
+    by_size: dict[int, list[float]] = {}
+    for r in runs:
+        for row in r.rows_at(r.final_generation):
+            size = len(str(row["subset"]).split("+"))
+            by_size.setdefault(size, []).append(float(row["teams_per_decision"]))
+    head = ["tasks in subset", "champions", "min", "median", "max"]
+    rows = [
+        [str(k), str(len(v)), f"{min(v):.2f}", f"{np.median(v):.2f}", f"{max(v):.2f}"]
+        for k, v in sorted(by_size.items())
+    ]
+    return head, rows
+
+
+def verdict(ours: float, paper: float) -> str:
+    """``ahead``, ``level`` or ``behind`` the paper's figure (within :data:`LEVEL`)."""
+    if not np.isfinite(ours):
+        return "n/a"
+    return "ahead" if ours > paper + LEVEL else "level" if ours >= paper - LEVEL else "behind"
+
+
+def first_reached(run, task: str, best_single: float, level: float) -> str:
+    """First test point at which the run's all-task champion reached ``level`` in ``task``."""
+    from mtpg.analysis.runs import normalise_scores
+
+    gens, scores = run.curve(run.full_set, task)
+    for g, s in zip(gens, scores, strict=True):
+        if normalise_scores({task: float(s)}, {task: best_single})[task] >= level:
+            return str(int(g))
+    return "not yet"
+
+
+def compare_table(best, best_single: dict[str, float], tasks) -> list[str]:
+    """Per task: the best run's all-task champion against the paper's Figs. 5 and 6."""
+    from mtpg.analysis.runs import normalise_scores
+
+    vs = normalise_scores(best.test, best_single)
+    paper = PAPER["best_vs_single"]
+    head = [
+        "task",
+        "test return",
+        "best single-task return",
+        "vs single",
+        f"paper (about {paper})",
+        f"first reached {paper - LEVEL:.2f}",
+        "vs reference",
+    ]
+    rows = [
+        [
+            t,
+            f"{best.test[t]:.4g}",
+            f"{best_single[t]:.4g}",
+            f"{vs[t]:.2f}",
+            verdict(vs[t], paper),
+            first_reached(best.run, t, best_single[t], paper - LEVEL),
+            f"{best.normalised[t]:.2f}",
+        ]
+        for t in tasks
+    ]
+    n90 = sum(best.normalised[t] >= 0.9 for t in tasks)
+    note = (
+        f"Against the reference best, the best run's all-task champion is at 0.9 or more in "
+        f"{n90} of {len(tasks)} tasks (paper: {PAPER['vs_reference']})."
+    )
+    return [*markdown_table(head, rows), "", note]
+
+
+def ablation_rows(groups, numbers, best_single, tasks) -> tuple[list[str], list[list[str]]]:
+    """Each ablation's best run against the best single-task champion, beside the paper."""
+    from mtpg.analysis.numbers import best_of
+    from mtpg.analysis.runs import normalise_scores
+
+    head = ["experiment", "run", "generation", "min vs single", "max vs single", "paper"]
+    rows = []
+    for g in groups:
+        n = best_of([numbers[r.path] for r in g.runs])
+        vs = list(normalise_scores(n.test, best_single).values())
+        rows.append(
+            [
+                g.label,
+                n.run.name,
+                str(n.generation),
+                f"{np.nanmin(vs):.2f}",
+                f"{np.nanmax(vs):.2f}",
+                PAPER.get(
+                    g.experiment, f"about {PAPER['best_vs_single']} in every task (best run)"
+                ),
+            ]
+        )
+    return head, rows
+
+
+#: Offset of the block of held-out episodes the champions are re-scored on.
+RESCORE_OFFSET = 500_000
+
+
+def rescore_rows(runs) -> tuple[list[str], list[list[str]]]:
+    """Each run's all-task champion: its test return with a 95% interval, and a re-score.
+
+    The interval is ``1.96 * std / sqrt(n)`` over the run's own ``n`` test episodes (the
+    scores of ``tests.csv``); the re-score plays ``n`` other held-out episodes
+    (:data:`RESCORE_OFFSET`), which should fall inside it about 95% of the time.
+    """
+    from mtpg.analysis.evaluate import evaluate_graph
+    from mtpg.analysis.numbers import champion_path
+    from mtpg.io.serialize import load_graph
+
+    tasks = runs[0].tasks
+    head = ["run", "generation", *tasks]
+    rows = []
+    for r in runs:
+        pop, root, _ = load_graph(champion_path(r))
+        ev = r.config.evaluation
+        n = ev.test_episodes
+        own = evaluate_graph(pop, root, list(tasks), n, 0, no_memory=ev.no_memory)
+        other = evaluate_graph(pop, root, list(tasks), n, RESCORE_OFFSET, no_memory=ev.no_memory)
+        cells = [
+            f"{own[t].mean:.4g} ± {1.96 * own[t].std / np.sqrt(n):.2g} ({other[t].mean:.4g})"
+            for t in tasks
+        ]
+        rows.append([r.name, str(r.final_generation), *cells])
+    return head, rows

@@ -1,6 +1,6 @@
 """Run configuration: frozen dataclasses with one docstring per field, presets and TOML.
 
-Every default is the paper's value (Table 3, section 4; ``shared/spec/algorithm.md``), with
+Every default is the paper's value (Table 3, section 4; the project's specification), with
 ``team.n_elite`` as in the published run (25 per task subset) rather than Table 3's 50.
 A configuration is built from a preset, then a TOML file, then ``section.field=value``
 overrides; each step validates and names the offending field on error.

@@ -66,8 +66,13 @@ def test_train_prints_header_compiling_line_and_final_test(tmp_path, capsys):
     assert main(["train", *args, "--generations", "7", "--out", str(tmp_path / "r")]) == 0
     err = capsys.readouterr().err
     assert err.index("columns:") < err.index("compiling") < err.index("gen 1/7 |")
+    assert err.index("teams/dec = teams visited per decision") < err.index("compiling")
     assert "test@7 " in err.strip().splitlines()[-2]  # the last generation is a test point
     assert last_test(tmp_path / "r" / "tests.csv", "CartPole+CartCentering")[0] == 7
+    assert main(["train", "--resume", str(tmp_path / "r")]) == 0  # finished: nothing to do
+    err = capsys.readouterr().err
+    assert "compiling" not in err and "gen 8/7" not in err
+    assert err.strip().endswith(f"done: {tmp_path / 'r'}")
 
 
 def test_experiment_progress_reads_each_runs_metrics(tmp_path):

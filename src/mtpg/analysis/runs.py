@@ -6,7 +6,8 @@ a single-task champion (Figs. 5 and 7) or the reference best of the task (Fig. 6
 
 Runs are grouped by configuration: two runs belong to one group when their configurations
 are equal in everything but the seed and the settings that do not change what a run
-computes (``workers``, ``checkpoint_interval``). A group is labelled with its experiment
+computes (``workers``, ``checkpoint_interval`` and where it was evaluated: ``backend``,
+``address``, ``dask_workers``). A group is labelled with its experiment
 (``TPG`` or an ablation of section 5.2) plus, when needed to tell groups apart, the fields in
 which it differs. Groups that differ in more than the ablation switches are a mixture the
 figures cannot compare fairly: :func:`group_runs` reports them as warnings.
@@ -28,7 +29,7 @@ from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_FILE
 
 #: Settings that do not change what a run computes: ignored when grouping.
-NOT_GROUPED = ("seed", "workers", "checkpoint_interval")
+NOT_GROUPED = ("seed", "workers", "checkpoint_interval", "backend", "address", "dask_workers")
 #: The ablation switches (``section.field``): groups differing only in these are comparable.
 ABLATION_FIELDS = tuple(key for key, _ in ABLATIONS.values())
 

@@ -25,7 +25,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--episodes", type=int, default=100, help="episodes per task (default 100)")
     p.add_argument("--seed", type=int, default=0, help="test seed offset (default 0)")
     p.add_argument("--decompose-task", help="task of the decomposition figure")
-    p.add_argument("--out", metavar="DIR", help="output directory (default: GRAPH_analysis/)")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output directory (default: analysis/ inside a run directory, GRAPH_analysis/ "
+        "beside a graph file)",
+    )
     add_memory_option(p)
     p.set_defaults(func=run)
 

@@ -17,8 +17,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="experiment folder")
     p.add_argument("--preset", default="demo", help="configuration preset (default demo)")
     p.add_argument("--config", metavar="FILE", help="TOML file of settings")
-    p.add_argument("--tasks", help="comma-separated task names")
-    p.add_argument("--generations", type=int, help="generations per run")
+    p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
+    p.add_argument("--generations", type=int, help="generations per run (default: the preset's)")
     p.add_argument(
         "--set",
         action="append",

@@ -12,12 +12,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="figures and an HTML page from run directories",
         description="Draw the figures of paper section 5 (learning curves, normalised scores, "
         "ablations, teams per decision) and the statistics across seeds (interquartile mean "
-        "with 95%% stratified bootstrap confidence intervals, performance profile) from the "
+        "with 95% stratified bootstrap confidence intervals, performance profile) from the "
         "test results of one or more runs. Runs are grouped by configuration; runs that "
         "differ in more than the seed and the ablation switches are reported with a warning.",
     )
     p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="run directories")
-    p.add_argument("--out", metavar="DIR", help="output directory (default: RUN_DIR/report)")
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output directory (default: report/ inside the first RUN_DIR)",
+    )
     p.set_defaults(func=run)
 
 

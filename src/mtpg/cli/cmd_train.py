@@ -10,6 +10,16 @@ ABLATION_FLAGS = {
     "no_memory": "no-memory",
     "no_hierarchy": "no-hierarchy",
 }
+#: What each ablation switch does (section 5.2), for ``--help``.
+ABLATION_HELP = {
+    "no_crossover": "ablation TPG-NoXover: children are mutated copies of one parent, never "
+    "crossovers "
+    "(team.p_crossover=0)",
+    "no_memory": "ablation TPG-NoMemory: memory banks zeroed before every program execution "
+    "(evaluation.no_memory=true)",
+    "no_hierarchy": "ablation TPG-NoHierarchy: action pointers always atomic, no graphs "
+    "(team.p_atomic=1)",
+}
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -25,9 +35,18 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--config", metavar="FILE", help="TOML file of settings")
     p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
-    p.add_argument("--generations", type=int, help="generations to run")
-    p.add_argument("--seed", type=int, help="run seed")
-    p.add_argument("--workers", type=int, help="threads evaluating episodes")
+    p.add_argument(
+        "--generations",
+        type=int,
+        help="generations to run (default: the preset's: 1000 paper, 250 demo)",
+    )
+    p.add_argument("--seed", type=int, help="run seed (default 0)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="threads evaluating episodes (default: the preset's: 1 paper, 2 demo; give "
+        "--workers 2 or more for paper runs; results do not depend on it)",
+    )
     p.add_argument(
         "--backend",
         choices=("local", "dask"),
@@ -38,14 +57,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--dask-workers", type=int, metavar="N", help="start a local Dask cluster of N processes"
     )
     p.add_argument(
+        "--scheduler-wait",
+        type=float,
+        metavar="SECONDS",
+        help="seconds to wait for a Dask scheduler to connect or come back before the "
+        "generation is finished on this machine (default: 10, or $MTPG_SCHEDULER_WAIT); "
+        "not stored with the run",
+    )
+    p.add_argument(
         "--set",
         action="append",
         default=[],
         metavar="SECTION.FIELD=VALUE",
-        help="override any setting, e.g. --set team.n_elite=10 (repeatable)",
+        help="override any setting, e.g. --set team.n_elite=10; top-level fields take no "
+        "section, e.g. --set checkpoint_interval=5 (repeatable; fields: mtpg.config)",
     )
     for dest, name in ABLATION_FLAGS.items():
-        p.add_argument(f"--{name}", dest=dest, action="store_true", help=f"ablation: {name}")
+        p.add_argument(f"--{name}", dest=dest, action="store_true", help=ABLATION_HELP[dest])
     where = p.add_mutually_exclusive_group()
     where.add_argument(
         "--out", metavar="RUN_DIR", help="new run directory (default: runs/<preset>-seed<seed>)"
@@ -99,7 +127,31 @@ def _fresh_dir(base: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs the command.
+    """Runs the command, with ``--scheduler-wait`` in force (and put back) around it."""
+    import os
+
+    from mtpg.cli.main import UsageError
+    from mtpg.engine.dask_backend import SCHEDULER_WAIT_ENV
+
+    if args.scheduler_wait is None:
+        return _train(args)
+    if not 0 < args.scheduler_wait <= 3600:
+        raise UsageError(
+            f"--scheduler-wait must be in (0, 3600] seconds, got {args.scheduler_wait}"
+        )
+    old = os.environ.get(SCHEDULER_WAIT_ENV)
+    os.environ[SCHEDULER_WAIT_ENV] = repr(args.scheduler_wait)
+    try:
+        return _train(args)
+    finally:
+        if old is None:
+            del os.environ[SCHEDULER_WAIT_ENV]
+        else:
+            os.environ[SCHEDULER_WAIT_ENV] = old
+
+
+def _train(args: argparse.Namespace) -> int:
+    """Trains or resumes.
 
     Stop signals (SIGTERM, SIGINT, SIGHUP) end the run after the generation under way is
     complete and committed; a second one stops at once. Either way the exit status is

@@ -20,6 +20,8 @@ import os
 import sys
 import traceback
 
+from mtpg import __version__
+
 #: Command modules, in the order ``mtpg --help`` lists them.
 COMMAND_MODULES = (
     "mtpg.cli.cmd_envs",
@@ -61,6 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Tangled Program Graphs with temporal memory for multi-task RL.",
     )
     parser.add_argument("--debug", action="store_true", help="show tracebacks of errors")
+    parser.add_argument("--version", action="version", version=f"mtpg {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:

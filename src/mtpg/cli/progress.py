@@ -131,6 +131,8 @@ class Progress:
             "root may differ per task, so this is not the champion's score)\n"
             f"  test@G = the all-task champion's mean return on {test} per task at the last "
             "test point G (what `mtpg report` and `mtpg evaluate` show)\n"
+            "  teams/dec = teams visited per decision, mean over the generation's new roots in "
+            "training (1: no team passes the decision on)\n"
             f"  tasks: {names}"
         )
 
@@ -140,8 +142,13 @@ class Progress:
             self._header_done = True
 
     def begin(self, generation: int = 0) -> None:
-        """Prints the header and a line saying the next generation compiles first."""
+        """Prints the header and a line saying the next generation compiles first.
+
+        A run that has no generation left (a finished run resumed) gets the header only.
+        """
         self._write_header()
+        if generation >= self.total:
+            return
         text = (
             f"gen {generation + 1}/{self.total}: compiling the engine's kernels (cached after "
             "the first run), then evaluating..."

@@ -48,8 +48,33 @@ MIN_ROOTS_PER_BATCH = 8
 RESUBMITS = 3
 #: Episode tables kept on the cluster between evaluations (training and test tables).
 TABLES_KEPT = 4
-#: Seconds to wait for a scheduler or for the workers of a new local cluster.
-CONNECT_TIMEOUT = 30
+#: Seconds to wait for a scheduler (to connect, or to come back before it counts as lost)
+#: unless ``MTPG_SCHEDULER_WAIT`` (``mtpg train --scheduler-wait``) says otherwise: short
+#: enough that a run whose scheduler died with its job still finishes the generation on
+#: this machine and commits it within SLURM's default ``KillWait`` of 30 s.
+CONNECT_TIMEOUT = 10
+#: The environment variable that overrides :data:`CONNECT_TIMEOUT` (seconds).
+SCHEDULER_WAIT_ENV = "MTPG_SCHEDULER_WAIT"
+
+
+def scheduler_wait() -> float:
+    """Seconds to wait for the scheduler: ``MTPG_SCHEDULER_WAIT`` or :data:`CONNECT_TIMEOUT`.
+
+    Raises:
+        ConfigError: The variable is not a number of seconds in (0, 3600].
+    """
+    text = os.environ.get(SCHEDULER_WAIT_ENV, "").strip()
+    if not text:
+        return float(CONNECT_TIMEOUT)
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value <= 3600:
+        raise ConfigError(
+            f"{SCHEDULER_WAIT_ENV} (--scheduler-wait) must be seconds in (0, 3600], got {text!r}"
+        )
+    return value
 
 
 def graph_arrays(cp: CompiledPopulation) -> tuple:
@@ -135,7 +160,7 @@ class DaskEvaluator:
             cluster was lost.
         min_roots: Fewest roots per batch.
         timeout: Seconds to wait for the scheduler (to connect, and to reconnect before it
-            counts as lost); :data:`CONNECT_TIMEOUT` when None.
+            counts as lost); :func:`scheduler_wait` when None.
 
     Dask's own log messages in this process (the client's and, for a local cluster, the
     scheduler's and nannies') are silenced until :meth:`close`: a lost scheduler would
@@ -155,9 +180,9 @@ class DaskEvaluator:
     ) -> None:
         from distributed import Client, LocalCluster
 
+        timeout = scheduler_wait() if timeout is None else timeout
         log_level = logging.INFO if os.environ.get("MTPG_DEBUG") else logging.CRITICAL
         self._log_levels = _set_dask_log_level(log_level)
-        timeout = CONNECT_TIMEOUT if timeout is None else timeout
         self.address = address
         self.fallback_threads = fallback_threads
         self.min_roots = min_roots

@@ -1,0 +1,50 @@
+"""The wait for a Dask scheduler is short by default and can be set (within a KillWait)."""
+
+import socket
+import time
+
+import pytest
+
+from mtpg.cli.main import main
+from mtpg.engine import dask_backend
+from tinyruns import tiny_args
+
+pytest.importorskip("distributed")
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_default_wait_fits_inside_slurms_default_killwait(monkeypatch):
+    monkeypatch.delenv(dask_backend.SCHEDULER_WAIT_ENV, raising=False)
+    assert dask_backend.scheduler_wait() == dask_backend.CONNECT_TIMEOUT <= 15
+
+
+@pytest.mark.parametrize("text", ["0", "-1", "nan", "soon", "7200"])
+def test_a_bad_wait_is_refused_naming_the_variable(monkeypatch, text):
+    monkeypatch.setenv(dask_backend.SCHEDULER_WAIT_ENV, text)
+    with pytest.raises(ValueError, match="MTPG_SCHEDULER_WAIT"):
+        dask_backend.scheduler_wait()
+
+
+def test_scheduler_wait_option_bounds_the_wait_for_a_missing_scheduler(tmp_path, capsys):
+    address = f"tcp://127.0.0.1:{free_port()}"  # nothing listens there
+    args = ["train", *tiny_args(), "--generations", "1", "--backend", "dask"]
+    start = time.monotonic()
+    code = main(
+        [*args, "--address", address, "--scheduler-wait", "1", "--out", str(tmp_path / "r")]
+    )
+    took = time.monotonic() - start
+    assert code == 2
+    assert f"cannot reach the dask scheduler at {address}" in capsys.readouterr().err
+    assert took < 9  # the default wait (10 s) was not used
+    assert dask_backend.SCHEDULER_WAIT_ENV not in __import__("os").environ  # put back
+
+
+def test_scheduler_wait_option_is_checked(tmp_path, capsys):
+    code = main(["train", *tiny_args(), "--scheduler-wait", "0", "--out", str(tmp_path / "r")])
+    assert code == 2
+    assert "--scheduler-wait must be in (0, 3600]" in capsys.readouterr().err

@@ -9,17 +9,15 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.analysis.replay import Replay
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
 
-#: State slot of the hidden velocity each task's analysis tracks (section 6.3): CartPole
-#: the pole's angular velocity, Acrobot the first joint's (the paper's choice), the
-#: others their only velocity. The paper leaves CartPole's choice open; the pole's is
-#: the one its control depends on most.
-HIDDEN_VELOCITY: dict[str, int] = dict(zip(TASK_NAMES, (3, 2, 1, 1, 1, 1), strict=True))
+#: State slot of the hidden velocity each task's analysis tracks (section 6.3), each spec's
+#: ``velocity_slot``: CartPole the pole's angular velocity, Acrobot the first joint's (the
+#: paper's choice), the others their only velocity. The paper leaves CartPole's choice
+#: open; the pole's is the one its control depends on most.
+HIDDEN_VELOCITY: dict[str, int] = {t.name: t.velocity_slot for t in TASKS}
 #: Label of that variable.
-VELOCITY_NAME: dict[str, str] = dict(
-    zip(TASK_NAMES, ("theta_dot", "dtheta1", "v", "theta_dot", "velocity", "velocity"), strict=True)
-)
+VELOCITY_NAME: dict[str, str] = {t.name: t.velocity_name for t in TASKS}
 
 
 def final_teams(replay: Replay) -> np.ndarray:

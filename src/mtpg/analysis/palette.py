@@ -7,15 +7,11 @@ videos); the section-5 figures of :mod:`mtpg.analysis.plots` colour runs, not ta
 from __future__ import annotations
 
 from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
 
-#: One colour per task, in task-id order (matplotlib's colour-blind-safe "tab10" picks).
-TASK_COLOURS: dict[str, str] = dict(
-    zip(
-        TASK_NAMES,
-        ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"),
-        strict=True,
-    )
-)
+#: One colour per task, each spec's ``colour`` (the six are matplotlib's colour-blind-safe
+#: "tab10" picks).
+TASK_COLOURS: dict[str, str] = {t.name: t.colour for t in TASKS}
 #: Colours of the three atomic discrete actions (Fig. 12 style decompositions).
 ACTION_COLOURS: tuple[str, ...] = ("#0072b2", "#e69f00", "#cc79a7")
 #: Colormap of continuous actions.

@@ -21,15 +21,11 @@ import time
 from pathlib import Path
 from typing import TextIO
 
-#: Short task labels for the status line (the header spells them out).
-SHORT = {
-    "CartPole": "CP",
-    "Acrobot": "AB",
-    "CartCentering": "CC",
-    "Pendulum": "PD",
-    "MountainCar": "MC",
-    "MountainCarContinuous": "MCC",
-}
+from mtpg.envs.registry import TASKS
+
+#: Short task labels for the status line (the header spells them out): each spec's
+#: ``short``.
+SHORT = {t.name: t.short for t in TASKS}
 
 
 def _fmt_rate(x: float) -> str:

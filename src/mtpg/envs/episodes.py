@@ -4,18 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
 from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT, TASK_NAMES
+from mtpg.envs.registry import TASKS
 from mtpg.envs.tasks import MAX_STEPS, P_FORCE, TASK_PARAMS
 
-_SAMPLERS = (
-    cartpole.sample_start,
-    acrobot.sample_start,
-    cartcentering.sample_start,
-    pendulum.sample_start,
-    mountaincar.sample_start,
-    mountaincar.sample_start,
-)
+_SAMPLERS = tuple(t.kernel("sample_start") for t in TASKS)
 
 
 def _check_task(task: int) -> int:

@@ -19,9 +19,6 @@ Conventions (used by the stored figures and by the re-measuring functions):
 
 from __future__ import annotations
 
-import math
-from typing import NamedTuple
-
 import numpy as np
 
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
@@ -31,6 +28,8 @@ from mtpg.envs.protocol import (  # noqa: F401  (the seed bases live in protocol
     TEST_SEED_BASE,
     held_out_seeds,
 )
+from mtpg.envs.registry import TASKS
+from mtpg.envs.taskspec import Reference
 
 #: Seed of the random agent's action generator.
 RANDOM_ACTION_SEED = 12345
@@ -49,24 +48,6 @@ def make_test_seeds(n: int = N_TEST_EPISODES) -> np.ndarray:
         int64 [n] seeds.
     """
     return held_out_seeds(n)
-
-
-class Reference(NamedTuple):
-    """Reference figures of one task.
-
-    Attributes:
-        random: Mean score of the random agent (see the module docstring).
-        random_std: Standard deviation of that score.
-        best: Reference best score (Fig. 5 normalisation).
-        solved: Registered solved threshold, or NaN when there is none.
-        source: Where ``best`` comes from.
-    """
-
-    random: float
-    random_std: float
-    best: float
-    solved: float
-    source: str
 
 
 def measure_random(
@@ -124,39 +105,11 @@ def measure_time_optimal_cartcentering(
     return float(returns.mean()), float(steps.mean()), int(captured.sum())
 
 
-_NONE = math.nan
-
-# One entry per task id. ``random`` / ``random_std``: measured by this project with
-# ``measure_random(task)`` (10,000 episodes, conventions in the module docstring), numpy 2.4,
-# numba 0.68. Re-measured by ``tests/envs/test_reference.py`` (slow).
-REFERENCE: tuple[Reference, ...] = (
-    # CartPole: best = solved = 195, Gym/Gymnasium CartPole-v0 reward_threshold.
-    Reference(18.9678, 10.431719089392697, 195.0, 195.0, "CartPole-v0 reward_threshold"),
-    # Acrobot: best = solved = -100, Gym/Gymnasium Acrobot-v1 reward_threshold (the paper's
-    # D4PG figure could not be traced for Gym's Acrobot; spec/environments.md).
-    Reference(-500.0, 0.0, -100.0, -100.0, "Acrobot-v1 reward_threshold"),
-    # CartCentering: best = mean score of Koza's time-optimal law under this implementation
-    # on the test episodes (seeds 1_000_000..1_000_099), measure_time_optimal_cartcentering();
-    # all 100 captured, mean 126.73 steps. No registered threshold.
-    Reference(
-        -0.9873404751314238,
-        0.2377274856515104,
-        -0.028608253024208153,
-        _NONE,
-        "time-optimal law, measured on the test seeds",
-    ),
-    # Pendulum: best = -123.11 +- 6.86, D4PG (msinto93), the top Pendulum-v0 entry of the
-    # OpenAI Gym wiki leaderboard, 100 test episodes. No registered threshold.
-    Reference(-1234.575608635256, 289.45830639340454, -123.11, _NONE, "Gym leaderboard, D4PG"),
-    # MountainCar: best = solved = -110, Gym/Gymnasium MountainCar-v0 reward_threshold.
-    Reference(-200.0, 0.0, -110.0, -110.0, "MountainCar-v0 reward_threshold"),
-    # MountainCarContinuous: best = solved = 90, MountainCarContinuous-v0 reward_threshold.
-    Reference(
-        -33.10653758859584, 4.803512011466331, 90.0, 90.0, "MountainCarContinuous-v0 threshold"
-    ),
-)
-
-assert len(REFERENCE) == len(TASK_NAMES)
+#: One entry per task id, from the registry (each spec's ``reference``, with its source
+#: in ``mtpg.envs.registry``). ``random`` / ``random_std``: measured by this project with
+#: ``measure_random(task)`` (10,000 episodes, conventions in the module docstring).
+#: Re-measured by ``tests/envs/test_reference.py`` (slow).
+REFERENCE: tuple[Reference, ...] = tuple(t.reference for t in TASKS)
 
 
 def normalise(

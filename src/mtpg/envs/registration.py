@@ -1,4 +1,4 @@
-"""Registers the six tasks with Gymnasium under the ``mtpg/`` namespace.
+"""Registers every task of the registry with Gymnasium under the ``mtpg/`` namespace.
 
 Only Gymnasium is imported here; the environment class (and numba) loads when an
 environment is made.
@@ -6,10 +6,10 @@ environment is made.
 
 from __future__ import annotations
 
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
 
 #: Gymnasium ids, in task-id order.
-GYM_IDS: tuple[str, ...] = tuple(f"mtpg/{name}-v0" for name in TASK_NAMES)
+GYM_IDS: tuple[str, ...] = tuple(t.gym_id for t in TASKS)
 
 ENTRY_POINT = "mtpg.envs.gym_env:MtpgEnv"
 

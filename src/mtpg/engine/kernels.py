@@ -19,18 +19,8 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from mtpg.engine.ops import apply_op
-from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
-from mtpg.envs.core import (
-    ACROBOT,
-    CARTCENTERING,
-    CARTPOLE,
-    MOUNTAINCAR,
-    PENDULUM,
-    STATE_SIZE,
-    STEP_SLOT,
-)
-from mtpg.envs.kernels import env_observe_row, env_reset
-from mtpg.envs.tasks import P_MAX_STEPS
+from mtpg.envs.core import STATE_SIZE
+from mtpg.envs.kernels import env_observe_row, env_reset, task_step
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
 _CONSTANTS = CONSTANTS.copy()
@@ -261,24 +251,8 @@ def run_jobs_queue(
                     base,
                 )
                 stamp += 1
-                # The step of mtpg.envs.kernels.env_step, dispatched here rather than called:
-                # a call passing the state and parameter arrays costs four atomic reference
-                # count updates per step (about 4% of the one-thread run time), which a call
-                # from this loop does not. The parity tests run every task through this loop.
-                state[STEP_SLOT] += 1.0
-                if task == CARTPOLE:
-                    reward, terminated = cartpole.step(p, state, a_d)
-                elif task == ACROBOT:
-                    reward, terminated = acrobot.step(p, state, a_c)
-                elif task == CARTCENTERING:
-                    reward, terminated = cartcentering.step(p, state, a_d)
-                elif task == PENDULUM:
-                    reward, terminated = pendulum.step(p, state, a_c)
-                elif task == MOUNTAINCAR:
-                    reward, terminated = mountaincar.step_discrete(p, state, a_d)
-                else:
-                    reward, terminated = mountaincar.step_continuous(p, state, a_c)
-                truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]
+                # The one task dispatch, inlined (no call passing the arrays per step).
+                reward, terminated, truncated = task_step(task, p, state, a_d, a_c)
                 total += reward
                 t += 1
                 if terminated or truncated:

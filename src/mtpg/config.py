@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import PAPER_TASKS
 from mtpg.limits import LIMITS
 
 
@@ -133,7 +134,7 @@ class TeamConfig:
 class EvaluationConfig:
     """Tasks, episodes and the test protocol (section 4.1 step 3, section 5)."""
 
-    tasks: tuple[str, ...] = TASK_NAMES
+    tasks: tuple[str, ...] = PAPER_TASKS
     """Active tasks, by name; the power set of these drives selection."""
     train_episodes: int = 5
     """Episodes per task on which each new root is evaluated (seeds 0..n-1)."""

@@ -63,9 +63,9 @@ def resolve_graph(target: Path):
         meta.setdefault("test_episodes", config.evaluation.test_episodes)
         return pop, root, meta, tasks
     pop, root, meta = load_graph(target)
-    from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.registry import PAPER_TASKS
 
-    return pop, root, meta, list(meta.get("tasks", TASK_NAMES))
+    return pop, root, meta, list(meta.get("tasks", PAPER_TASKS))
 
 
 def run(args: argparse.Namespace) -> int:

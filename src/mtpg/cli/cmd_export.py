@@ -92,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.registry import PAPER_TASKS
     from mtpg.export.common import prepare
     from mtpg.io.serialize import load_graph
 
@@ -121,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
                 raise UsageError(str(exc)) from exc
     if not args.bench:
         return 0
-    tasks = run_tasks or list(meta.get("tasks", TASK_NAMES))
+    tasks = run_tasks or list(meta.get("tasks", PAPER_TASKS))
     if args.tasks:
         tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
     unknown = [t for t in tasks if t not in TASK_NAMES]

@@ -255,8 +255,7 @@ TASK_NAMES: tuple[str, ...] = tuple(t.name for t in TASKS)
 #: The paper's six tasks (Table 1): the default task set of a run, whatever else is
 #: registered, so that registering a task changes no existing configuration.
 PAPER_TASKS: tuple[str, ...] = tuple(
-    t.name
-    for t in (CARTPOLE, ACROBOT, CARTCENTERING, PENDULUM, MOUNTAINCAR, MOUNTAINCARCONTINUOUS)
+    t.name for t in (CARTPOLE, ACROBOT, CARTCENTERING, PENDULUM, MOUNTAINCAR, MOUNTAINCARCONTINUOUS)
 )
 
 if len(set(TASK_NAMES)) != len(TASKS) or len({t.short for t in TASKS}) != len(TASKS):

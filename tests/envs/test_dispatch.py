@@ -20,7 +20,7 @@ from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe, env_reset, env_step
 from mtpg.envs.core import N_TASKS, STATE_SIZE, STEP_SLOT
 from mtpg.envs.registry import TASKS
-from mtpg.envs.tasks import TASK_PARAMS
+from mtpg.envs.tasks import P_KIND, TASK_PARAMS
 from mtpg.export.harness import engine_stream
 
 SEEDS = [0, 1]
@@ -99,7 +99,9 @@ def test_an_id_without_a_branch_is_loud(graph):
     """What a kernel missing a task does: NaN observation, NaN reward, episode over."""
     pop, root = graph
     missing = N_TASKS
-    params = np.vstack([TASK_PARAMS, TASK_PARAMS[:1]])
+    row = TASK_PARAMS[:1].copy()
+    row[0, P_KIND] = missing  # a row whose kind has no branch
+    params = np.vstack([TASK_PARAMS, row])
     state = np.zeros(STATE_SIZE)
     obs = np.zeros(2)
     env_reset(missing, params, np.zeros(STATE_SIZE), state)

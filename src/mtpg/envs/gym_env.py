@@ -20,11 +20,10 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from mtpg.envs.core import N_OBS, STATE_SIZE, TASK_NAMES
+from mtpg.envs.core import N_OBS, STATE_SIZE
 from mtpg.envs.episodes import sample_start
 from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.registry import TASKS
-from mtpg.envs.tasks import STATE_DIMS, TASK_PARAMS, USES_CONTINUOUS
+from mtpg.envs.variants import n_tasks, resolve, spec_of, task_params
 
 #: The action interfaces: the paper's pair, or the task's own single action.
 ACTIONS: tuple[str, ...] = ("paper", "native")
@@ -45,7 +44,7 @@ def paper_action_space() -> spaces.Tuple:
 
 def native_action_space(task: int) -> spaces.Space:
     """The task's own action: ``Discrete(3)``, or ``Box(-bound, bound, (1,), float64)``."""
-    spec = TASKS[task]
+    spec = spec_of(task)
     if spec.continuous:
         return spaces.Box(-spec.bound, spec.bound, (1,), dtype=np.float64)
     return spaces.Discrete(3)
@@ -53,7 +52,7 @@ def native_action_space(task: int) -> spaces.Space:
 
 def native_to_pair(task: int, action: Any) -> tuple[int, float]:
     """The paper's ``(a_d, a_c)`` of a native action (the unread one neutral: 1 or 0.0)."""
-    if TASKS[task].continuous:
+    if spec_of(task).continuous:
         return 1, float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
     return int(np.asarray(action).reshape(-1)[0]), 0.0
 
@@ -69,15 +68,17 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
     needed.
 
     Args:
-        task: The task id (index into ``TASK_NAMES``).
+        task: The task id (index into ``TASK_NAMES``), or a task or variant name
+            (``"CartPole[max_steps=500]"``, see :mod:`mtpg.envs.variants`).
         render_mode: None or ``"rgb_array"``.
         action: ``"paper"`` or ``"native"``.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
 
-    def __init__(self, task: int, render_mode: str | None = None, action: str = "paper"):
-        if not 0 <= int(task) < len(TASK_NAMES):
+    def __init__(self, task: int | str, render_mode: str | None = None, action: str = "paper"):
+        task = resolve(task) if isinstance(task, str) else int(task)
+        if not 0 <= task < n_tasks():
             raise ValueError(f"unknown task id {task}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unsupported render_mode {render_mode!r}")
@@ -90,10 +91,11 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         self.action_space = (
             native_action_space(self._task) if self._native else paper_action_space()
         )
-        self._params = TASK_PARAMS
+        self._params = task_params()
         self._state = np.zeros(STATE_SIZE, dtype=np.float64)
         self._obs = np.zeros(N_OBS, dtype=np.float64)
-        self._dim = int(STATE_DIMS[self._task])
+        self._dim = spec_of(self._task).state_dim
+        self._continuous = spec_of(self._task).continuous
         self._last_action = 0.0
         self._renderer: Any = None
 
@@ -136,7 +138,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         """
         a_d, a_c = native_to_pair(self._task, action) if self._native else _parse_action(action)
         reward, terminated, truncated = env_step(self._task, self._params, self._state, a_d, a_c)
-        self._last_action = a_c if USES_CONTINUOUS[self._task] else 0.0
+        self._last_action = a_c if self._continuous else 0.0
         return self._observe(), float(reward), bool(terminated), bool(truncated), self._info()
 
     def render(self) -> np.ndarray | None:

@@ -5,9 +5,14 @@ to the task modules, with a branch per task of the registry (:mod:`mtpg.envs.reg
 Every kernel (these, the batch kernel of training, the traced kernel) reaches the task
 modules through them. An id without a branch observes NaN and ends its episode at once
 with a NaN reward, so a task missing from the chain cannot pass for another task
-(``tests/envs/test_dispatch.py`` plays every registered task through every kernel). State lives
-in a float64 array of ``STATE_SIZE`` slots (see ``mtpg.envs.core``); parameters are
-``TASK_PARAMS`` (see ``mtpg.envs.tasks``).
+(``tests/envs/test_dispatch.py`` plays every registered task through every kernel).
+
+The dispatch branches on a row's ``kind`` column (``P_KIND``): a registered task's own id,
+or a variant's base task id (:mod:`mtpg.envs.variants`), so a variant runs its base task's
+kernels on its own parameter row; a row whose ``P_OBS`` column is set is observed by
+:func:`variant_observe`. State lives in a float64 array of ``STATE_SIZE`` slots (see
+``mtpg.envs.core``); parameters are rows of ``TASK_PARAMS`` (see ``mtpg.envs.tasks``) or of
+``mtpg.envs.variants.task_params()``.
 
 Action conventions: a non-finite ``a_c`` is treated as 0 and then clipped to the task's
 bound; an ``a_d`` outside {0, 1, 2} is treated as 1 ("repeat the previous force" in
@@ -20,6 +25,7 @@ import numpy as np
 from numba import njit
 
 from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
+from mtpg.envs._util import clip_obs
 from mtpg.envs.core import (
     ACROBOT,
     CARTCENTERING,
@@ -31,7 +37,16 @@ from mtpg.envs.core import (
     STATE_SIZE,
     STEP_SLOT,
 )
-from mtpg.envs.tasks import P_FORCE, P_MAX_STEPS
+from mtpg.envs.tasks import (
+    P_FORCE,
+    P_KIND,
+    P_MAX_STEPS,
+    P_OBS,
+    P_OBS_HI,
+    P_OBS_LO,
+    P_OBS_SLOT,
+    P_OBS_WRAP,
+)
 
 
 @njit(cache=True, error_model="numpy")
@@ -63,23 +78,49 @@ def env_observe(
         noise: The episode's U[0, 1] noise value for this step (used by one-input tasks).
         obs: Output array of at least two slots.
     """
-    env_observe_row(task, params[task], state, noise, obs)
+    p = params[task]
+    env_observe_row(np.int64(p[P_KIND]), p, state, noise, obs)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def variant_observe(p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray) -> None:
+    """A variant's observation: each input a state slot scaled to [-1, 1], or the noise.
+
+    Args:
+        p: The variant's parameter row (columns ``P_OBS_*``).
+        state: The current state array.
+        noise: The episode's U[0, 1] noise value for this step.
+        obs: Output array of at least two slots.
+    """
+    for i in range(2):
+        slot = np.int64(p[P_OBS_SLOT + i])
+        if slot < 0:
+            obs[i] = clip_obs(noise)
+        else:
+            x = state[slot]
+            if p[P_OBS_WRAP + i] != 0.0:
+                x = pendulum.angle_normalize(x)
+            lo = p[P_OBS_LO + i]
+            obs[i] = clip_obs(2.0 * (x - lo) / (p[P_OBS_HI + i] - lo) - 1.0)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def task_observe(
-    task: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
+    kind: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
 ) -> None:
-    """The observation dispatch: writes the two inputs of task ``task``.
+    """The observation dispatch: writes the two inputs of a parameter row.
 
     Args:
-        task: The task id.
-        p: The task's parameter row.
+        kind: The row's base task id (``p[P_KIND]``).
+        p: The parameter row.
         state: The current state array.
         noise: The episode's U[0, 1] noise value for this step.
         obs: Output array of at least two slots (NaN for an id without a branch).
     """
-    if task == CARTPOLE:
+    task = kind
+    if p[P_OBS] != 0.0:
+        variant_observe(p, state, noise, obs)
+    elif task == CARTPOLE:
         cartpole.observe(p, state, noise, obs)
     elif task == ACROBOT:
         acrobot.observe(p, state, noise, obs)
@@ -96,17 +137,17 @@ def task_observe(
 
 @njit(cache=True, error_model="numpy", inline="always")
 def task_step(
-    task: int, p: np.ndarray, state: np.ndarray, a_d: int, a_c: float
+    kind: int, p: np.ndarray, state: np.ndarray, a_d: int, a_c: float
 ) -> tuple[float, bool, bool]:
-    """The step dispatch: advances task ``task`` by one step in place.
+    """The step dispatch: advances the task of a parameter row by one step in place.
 
     Inlined into its callers (``inline="always"``), so that the batch kernel's episode
     loop pays no call passing the state and parameter arrays (each such call costs atomic
     reference-count updates).
 
     Args:
-        task: The task id.
-        p: The task's parameter row.
+        kind: The row's base task id (``p[P_KIND]``): which kernels play it.
+        p: The parameter row.
         state: The state array, updated in place.
         a_d: The discrete action (read by the discrete tasks).
         a_c: The continuous action (read by the continuous tasks).
@@ -114,6 +155,7 @@ def task_step(
     Returns:
         (reward, terminated, truncated); an id without a branch gives (NaN, True, False).
     """
+    task = kind
     state[STEP_SLOT] += 1.0
     if task == CARTPOLE:
         reward, terminated = cartpole.step(p, state, a_d)
@@ -135,14 +177,14 @@ def task_step(
 
 @njit(cache=True, error_model="numpy")
 def env_observe_row(
-    task: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
+    kind: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
 ) -> None:
-    """:func:`env_observe` given the task's parameter row ``p = params[task]``.
+    """:func:`env_observe` given the parameter row ``p = params[task]`` and its ``kind``.
 
-    The batch kernel takes the row once per episode: making it (an array view) at every
-    step costs reference-count updates.
+    The batch kernel takes the row and its kind (``p[P_KIND]``) once per episode: making
+    the row (an array view) at every step costs reference-count updates.
     """
-    task_observe(task, p, state, noise, obs)
+    task_observe(kind, p, state, noise, obs)
 
 
 @njit(cache=True, error_model="numpy")
@@ -162,4 +204,5 @@ def env_step(
         (reward, terminated, truncated); truncated is True when the step count reaches the
         task's time limit without termination.
     """
-    return task_step(task, params[task], state, a_d, a_c)
+    p = params[task]
+    return task_step(np.int64(p[P_KIND]), p, state, a_d, a_c)

@@ -59,7 +59,7 @@ def measure_random(
     """Measures the random agent's mean score (the ``random`` of the normalisation).
 
     Args:
-        task: The task id.
+        task: The task id (a variant's too: its reference scores are measured this way).
         n: Number of episodes.
         seed: Seed of the action generator.
         seed_base: Episode ``i`` uses episode seed ``seed_base + i``.
@@ -69,10 +69,11 @@ def measure_random(
     """
     from mtpg.envs.episodes import make_episodes
     from mtpg.envs.rollout import run_episodes
-    from mtpg.envs.tasks import ACTION_BOUND, MAX_STEPS, TASK_PARAMS
+    from mtpg.envs.variants import spec_of, task_params
 
-    limit = int(MAX_STEPS[task])
-    bound = float(ACTION_BOUND[task])
+    spec = spec_of(task)
+    limit = spec.max_steps
+    bound = spec.bound
     rng = np.random.default_rng(seed)
     returns = np.zeros(n)
     for lo in range(0, n, _CHUNK):
@@ -80,7 +81,7 @@ def measure_random(
         starts, noise = make_episodes(np.full(m, task), seed_base + lo + np.arange(m))
         a_d = rng.integers(0, 3, (m, limit))
         a_c = rng.uniform(-bound, bound, (m, limit))
-        returns[lo : lo + m] = run_episodes(task, TASK_PARAMS, starts, noise, a_d, a_c)
+        returns[lo : lo + m] = run_episodes(task, task_params(), starts, noise, a_d, a_c)
     return float(returns.mean()), float(returns.std())
 
 

@@ -40,6 +40,17 @@ CARTPOLE = TaskSpec(
         2.4,  # |x| failure threshold [m]
         12 * 2 * math.pi / 360,  # |theta| failure threshold [rad]
     ),
+    param_names=(
+        "max_steps",
+        "force",
+        "tau",
+        "gravity",
+        "masscart",
+        "masspole",
+        "length",
+        "x_threshold",
+        "theta_threshold",
+    ),
     state_names=("x", "x_dot", "theta", "theta_dot"),
     # x and theta: their failure thresholds; the velocities: ranges a balancing episode
     # stays well within (Gymnasium leaves them unbounded).
@@ -78,6 +89,20 @@ ACROBOT = TaskSpec(
         4 * math.pi,  # |dtheta1| bound
         9 * math.pi,  # |dtheta2| bound
     ),
+    param_names=(
+        "max_steps",
+        "max_torque",
+        "dt",
+        "link_length_1",
+        "link_mass_1",
+        "link_mass_2",
+        "link_com_pos_1",
+        "link_com_pos_2",
+        "link_moi",
+        "gravity",
+        "max_vel_1",
+        "max_vel_2",
+    ),
     state_names=("theta1", "theta2", "dtheta1", "dtheta2"),
     state_low=(-_PI, -_PI, -4 * _PI, -9 * _PI),
     state_high=(_PI, _PI, 4 * _PI, 9 * _PI),
@@ -111,6 +136,17 @@ CARTCENTERING = TaskSpec(
         0.01,  # capture box half-width, for both x and v
         0.75,  # start x, v ~ U[-0.75, 0.75]
         0.1,  # weight of the elapsed-time term of the terminal penalty
+    ),
+    param_names=(
+        "max_steps",
+        "force",
+        "tau",
+        "mass",
+        "max_speed",
+        "x_bound",
+        "capture",
+        "start_range",
+        "time_cost",
     ),
     state_names=("x", "v"),
     state_low=(-1.5, -6.0),
@@ -151,6 +187,7 @@ PENDULUM = TaskSpec(
         1.0,  # length [m]
         8.0,  # |theta_dot| bound
     ),
+    param_names=("max_steps", "max_torque", "dt", "gravity", "mass", "length", "max_speed"),
     state_names=("theta", "theta_dot"),
     state_low=(-_PI, -8.0),
     state_high=(_PI, 8.0),
@@ -168,6 +205,11 @@ PENDULUM = TaskSpec(
     colour="#d62728",
     render="PendulumEnv",
 )
+
+_MC_PARAMS = (
+    "max_steps", "force", "gravity", "min_position", "max_position", "max_speed",
+    "goal_position", "goal_velocity", "goal_reward", "action_cost", "power",
+)  # fmt: skip
 
 _MC_STATE = dict(
     state_names=("position", "velocity"),
@@ -199,6 +241,7 @@ MOUNTAINCAR = TaskSpec(
         0.0,  # action cost (unused)
         0.0,  # engine power (unused)
     ),
+    param_names=_MC_PARAMS,
     action="discrete",
     action_text="a_d: +1/0/-1 push",
     # best = solved = -110, Gym/Gymnasium MountainCar-v0 reward_threshold.
@@ -228,6 +271,7 @@ MOUNTAINCARCONTINUOUS = TaskSpec(
         0.1,  # cost per squared (clipped) force
         0.0015,  # engine power: the velocity change is force * power
     ),
+    param_names=_MC_PARAMS,
     action="continuous",
     action_text="a_c: force in [-1,1]",
     # best = solved = 90, Gym/Gymnasium MountainCarContinuous-v0 reward_threshold.

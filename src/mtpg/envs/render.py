@@ -14,7 +14,8 @@ from mtpg.envs import cartcentering
 from mtpg.envs._util import clip
 from mtpg.envs.core import CARTCENTERING, PENDULUM
 from mtpg.envs.registry import spec
-from mtpg.envs.tasks import STATE_DIMS, TASK_PARAMS
+from mtpg.envs.tasks import TASK_PARAMS
+from mtpg.envs.variants import spec_of
 
 
 class GymRenderer:
@@ -28,7 +29,9 @@ class GymRenderer:
         from gymnasium.envs import classic_control
 
         self.task = task
-        self.env: Any = getattr(classic_control, spec(task).render)(render_mode="rgb_array")
+        self.env: Any = getattr(classic_control, spec_of(task).render)(render_mode="rgb_array")
+        self.kind = spec_of(task).base or spec_of(task).name  # a variant draws as its base
+        self.dim = spec_of(task).state_dim
 
     def frame(self, state: np.ndarray, last_action: float) -> np.ndarray:
         """Renders one frame.
@@ -40,8 +43,8 @@ class GymRenderer:
         Returns:
             An ``H x W x 3`` uint8 frame.
         """
-        self.env.state = np.array(state[: STATE_DIMS[self.task]], dtype=np.float64)
-        if self.task == PENDULUM:
+        self.env.state = np.array(state[: self.dim], dtype=np.float64)
+        if self.kind == spec(PENDULUM).name:
             bound = spec(PENDULUM).bound
             self.env.last_u = clip(last_action, -bound, bound) if np.isfinite(last_action) else 0.0
         return np.asarray(self.env.render(), dtype=np.uint8)
@@ -118,7 +121,6 @@ def make_renderer(task: int) -> GymRenderer | CartCenteringRenderer:
     Returns:
         An object with ``frame(state, last_action)`` and ``close()``.
     """
-    name = spec(task).render
-    if name:
+    if spec_of(task).render:
         return GymRenderer(task)
-    return globals()[f"{spec(task).name}Renderer"]()
+    return globals()[f"{spec_of(task).base or spec_of(task).name}Renderer"]()

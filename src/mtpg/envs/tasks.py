@@ -27,30 +27,69 @@ P_MAX_STEPS = 0
 #: Common column: the discrete force magnitude or the continuous action bound.
 P_FORCE = 1
 
+#: Number of task columns (the longest parameter row of the registry).
+N_TASK_COLUMNS = max(len(t.params) for t in TASKS)
+
+# Interface columns, after every task's own: how the row is dispatched and observed.
+#: The base task's id: the dispatch of ``mtpg.envs.kernels`` branches on it.
+P_KIND = N_TASK_COLUMNS
+#: 0: the task's own observation kernel; 1: a variant's observation (columns below).
+P_OBS = N_TASK_COLUMNS + 1
+#: Two columns: the state slot each input observes (-1: the U[0, 1] noise input).
+P_OBS_SLOT = N_TASK_COLUMNS + 2
+#: Two columns: the value each observed slot maps to -1.
+P_OBS_LO = N_TASK_COLUMNS + 4
+#: Two columns: the value each observed slot maps to +1.
+P_OBS_HI = N_TASK_COLUMNS + 6
+#: Two columns: 1 when the observed slot is an angle wrapped into [-pi, pi) first.
+P_OBS_WRAP = N_TASK_COLUMNS + 8
+
 #: Number of columns of ``TASK_PARAMS``.
-N_PARAMS = max(len(t.params) for t in TASKS)
+N_PARAMS = N_TASK_COLUMNS + 10
 #: Number of tasks.
 N_TASKS = len(TASKS)
 
 
-def params_table(rows: tuple[tuple[float, ...], ...]) -> np.ndarray:
-    """Stacks parameter rows into a read-only float64 table, unused columns 0.
+def param_row(
+    params: tuple[float, ...],
+    kind: int,
+    observe: tuple[tuple[int, float, float, bool], ...] | None = None,
+) -> np.ndarray:
+    """One row of the parameter table: the task's columns, then the interface columns.
 
     Args:
-        rows: One parameter row per task.
+        params: The task's parameter row.
+        kind: The id of the task whose kernels play the row.
+        observe: None for the task's own observation, else up to two
+            ``(slot, low, high, wrap)`` inputs (a missing second input is noise).
 
     Returns:
-        float64 ``[len(rows), max(N_PARAMS, longest row)]``.
+        float64 ``[N_PARAMS]``; unused task columns are 0.
     """
-    table = np.zeros((len(rows), max([N_PARAMS, *map(len, rows)])), dtype=np.float64)
-    for i, row in enumerate(rows):
-        table[i, : len(row)] = row
+    row = np.zeros(N_PARAMS, dtype=np.float64)
+    row[: len(params)] = params
+    row[P_KIND] = kind
+    if observe is not None:
+        row[P_OBS] = 1.0
+        row[P_OBS_SLOT : P_OBS_SLOT + 2] = -1.0
+        for i, (slot, lo, hi, wrap) in enumerate(observe):
+            row[P_OBS_SLOT + i] = slot
+            row[P_OBS_LO + i] = lo
+            row[P_OBS_HI + i] = hi
+            row[P_OBS_WRAP + i] = float(wrap)
+    return row
+
+
+def params_table(rows: list[np.ndarray]) -> np.ndarray:
+    """Stacks rows of :func:`param_row` into a read-only float64 table."""
+    table = np.array(rows, dtype=np.float64).reshape(len(rows), N_PARAMS)
     table.setflags(write=False)
     return table
 
 
-#: float64 [N_TASKS, N_PARAMS]: every task constant (read-only).
-TASK_PARAMS: np.ndarray = params_table(tuple(t.params for t in TASKS))
+#: float64 [N_TASKS, N_PARAMS]: every task constant (read-only); variants add rows to
+#: ``mtpg.envs.variants.task_params()``.
+TASK_PARAMS: np.ndarray = params_table([param_row(t.params, i) for i, t in enumerate(TASKS)])
 
 #: int64 [N_TASKS]: time limits in steps (200, 500, 500, 200, 200, 999).
 MAX_STEPS: np.ndarray = np.array([t.max_steps for t in TASKS], dtype=np.int64)

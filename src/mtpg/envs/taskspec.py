@@ -50,6 +50,8 @@ class TaskSpec:
         params: The parameter row; column 0 is the time limit, column 1 the force
             magnitude (discrete) or action bound (continuous); the rest are named by the
             column constants of ``kernel_module``.
+        param_names: Name of each parameter column (the lower-case column constants of
+            ``kernel_module``); a variant overrides a parameter by this name.
         state_names: Names of the physical state variables, in Gymnasium's order.
         state_low: Per state variable, the low end of the range a variant's observation
             scales to -1 (see :mod:`mtpg.envs.variants`).
@@ -65,6 +67,8 @@ class TaskSpec:
         colour: The task's colour in every section-6 figure.
         render: Gymnasium ``classic_control`` class drawing the task, or ``""`` for a
             renderer of :mod:`mtpg.envs.render` named ``<name>Renderer``.
+        base: For a variant (:mod:`mtpg.envs.variants`), the name of its registered base
+            task; ``""`` for a registered task.
     """
 
     name: str
@@ -74,6 +78,7 @@ class TaskSpec:
     observe: str
     sample_start: str
     params: tuple[float, ...]
+    param_names: tuple[str, ...]
     state_names: tuple[str, ...]
     state_low: tuple[float, ...]
     state_high: tuple[float, ...]
@@ -86,6 +91,7 @@ class TaskSpec:
     velocity_slot: int
     colour: str
     render: str
+    base: str = ""
 
     def __post_init__(self) -> None:
         """Checks the spec's internal consistency (naming the field at fault)."""
@@ -94,6 +100,11 @@ class TaskSpec:
             (self.action in ACTION_KINDS, "action", f"must be one of {', '.join(ACTION_KINDS)}"),
             (len(self.params) >= 2, "params", "needs the time limit and the force/bound"),
             (float(self.params[0]) >= 1, "params", "time limit (column 0) must be >= 1"),
+            (
+                len(self.param_names) == len(self.params) and self.param_names[0] == "max_steps",
+                "param_names",
+                "needs one name per column, max_steps first",
+            ),
             (1 <= n <= 4, "state_names", "needs 1 to 4 state variables"),
             (len(self.state_low) == n, "state_low", "needs one value per state variable"),
             (len(self.state_high) == n, "state_high", "needs one value per state variable"),
@@ -142,6 +153,10 @@ class TaskSpec:
     @property
     def gym_id(self) -> str:
         """The Gymnasium id of the paper's two-action interface."""
+        if self.base:
+            from mtpg.envs.variants import gym_id
+
+            return gym_id(self.name)
         return f"mtpg/{self.name}-v0"
 
     def kernel(self, role: str) -> Any:

@@ -1,0 +1,228 @@
+"""Task variants as data: ``CartPole[max_steps=500]``, ``Pendulum[observe=theta]``.
+
+A variant is a registered task with some of its settings changed, written
+``Base[key=value;key=value]``. The keys:
+
+- any parameter of the base task by its name (``TaskSpec.param_names``, e.g. ``max_steps``,
+  ``gravity``): the parameter's value (``max_steps`` a whole number >= 1);
+- ``observe``: the one or two state variables the two inputs observe, joined by ``+``
+  (``observe=x+theta``), each scaled from the base spec's ``state_low..state_high`` to
+  [-1, 1] (angles wrapped into [-pi, pi) first) and clipped; with one variable the second
+  input is the U[0, 1] noise input, as in the paper's one-observable tasks.
+
+The dynamics are the base task's kernels on the variant's parameter row, so a variant
+reproduces its base task step for step and runs in the compiled engine like it. The start
+distribution is the base task's (parameters read only by the start sampler, such as
+CartCentering's ``start_range``, keep their base value there).
+
+A variant's name is canonical (keys sorted, values normalised): :func:`canonical` turns any
+spelling into it, and the configuration stores it as the task's name. Its id is handed out
+when the name is first resolved in a process (:func:`resolve`), after the registry's: ids
+are process-local, names are what runs, checkpoints and graph files store. The reference
+scores of a variant are unknown (NaN) unless measured
+(:func:`mtpg.envs.reference.measure_random`).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import replace
+
+import numpy as np
+
+from mtpg.envs.registry import TASK_NAMES, TASKS
+from mtpg.envs.taskspec import NONE, Reference, TaskSpec
+
+_NAME = re.compile(r"^(?P<base>[A-Za-z][A-Za-z0-9]*)\[(?P<body>[^\[\]]*)\]$")
+
+_VARIANTS: list[TaskSpec] = []
+_IDS: dict[str, int] = {name: i for i, name in enumerate(TASK_NAMES)}
+_TABLE: list[np.ndarray] = []
+_CACHE: dict[int, np.ndarray] = {}
+
+
+def is_variant(name: str) -> bool:
+    """Whether a task name is written as a variant (``Base[...]``)."""
+    return "[" in name
+
+
+def _fail(text: str, message: str) -> ValueError:
+    return ValueError(f"task {text!r}: {message}")
+
+
+def allowed_keys(base: TaskSpec) -> tuple[str, ...]:
+    """The keys a variant of ``base`` may set."""
+    return (*base.param_names, "observe")
+
+
+def _value(text: str, base: TaskSpec, key: str, raw: str) -> str:
+    """The canonical spelling of one value (raises naming the key and what is allowed)."""
+    if key == "observe":
+        names = raw.split("+")
+        bad = [n for n in names if n not in base.state_names]
+        if not raw or bad:
+            allowed = ", ".join(base.state_names)
+            what = f"unknown state variable {bad[0]!r}" if bad and bad[0] else "empty"
+            raise _fail(text, f"observe: {what}; allowed: {allowed} (one or two, joined by +)")
+        if len(names) > 2 or len(set(names)) != len(names):
+            raise _fail(text, "observe: one or two distinct state variables, joined by +")
+        return "+".join(names)
+    try:
+        number = float(raw)
+    except ValueError:
+        raise _fail(text, f"{key}: {raw!r} is not a number") from None
+    if not math.isfinite(number):
+        raise _fail(text, f"{key}: must be finite, got {raw!r}")
+    if key == "max_steps":
+        if number != int(number) or number < 1:
+            raise _fail(text, f"max_steps: a whole number >= 1, got {raw!r}")
+        return str(int(number))
+    return repr(number)
+
+
+def parse(text: str) -> tuple[TaskSpec, dict[str, str]]:
+    """Splits a variant string into its base spec and canonical ``key -> value`` settings.
+
+    Raises:
+        ValueError: One line naming the fault: an unknown base task, a malformed string, an
+            unknown key (with the allowed keys) or a bad value (with what is allowed).
+    """
+    m = _NAME.match(text.strip())
+    if m is None:
+        raise _fail(text, "write a variant as Base[key=value;key=value]")
+    if m["base"] not in TASK_NAMES:
+        raise _fail(text, f"unknown base task {m['base']!r}; choose from {', '.join(TASK_NAMES)}")
+    base = TASKS[TASK_NAMES.index(m["base"])]
+    settings: dict[str, str] = {}
+    for item in (i.strip() for i in m["body"].split(";")):
+        if not item:
+            continue
+        key, sep, raw = (s.strip() for s in item.partition("="))
+        if key not in allowed_keys(base):
+            allowed = ", ".join(allowed_keys(base))
+            raise _fail(text, f"unknown key {key!r}; allowed: {allowed}")
+        if not sep:
+            raise _fail(text, f"{key}: missing '=value'")
+        if key in settings:
+            raise _fail(text, f"{key}: set twice")
+        settings[key] = _value(text, base, key, raw)
+    if not settings:
+        raise _fail(text, f"no settings; allowed keys: {', '.join(allowed_keys(base))}")
+    return base, settings
+
+
+def canonical(text: str) -> str:
+    """The canonical name of a task: a registered name as it is, a variant normalised.
+
+    Raises:
+        ValueError: For an unknown task or a bad variant (see :func:`parse`).
+    """
+    if not is_variant(text):
+        if text not in TASK_NAMES:
+            raise ValueError(f"unknown task {text!r}; choose from {', '.join(TASK_NAMES)}")
+        return text
+    base, settings = parse(text)
+    return f"{base.name}[{';'.join(f'{k}={settings[k]}' for k in sorted(settings))}]"
+
+
+def gym_id(name: str) -> str:
+    """The Gymnasium id of a task or variant, e.g. ``mtpg/CartPole-max_steps_500-v0``."""
+    name = canonical(name)
+    if not is_variant(name):
+        return f"mtpg/{name}-v0"
+    base, settings = parse(name)
+    parts = [f"{k}_{settings[k].replace('+', '.')}" for k in sorted(settings)]
+    return f"mtpg/{base.name}-{'-'.join(parts)}-v0"
+
+
+def variant_spec(name: str) -> TaskSpec:
+    """The spec of a variant: the base spec with the settings applied."""
+    base, settings = parse(name)
+    params = list(base.params)
+    for key, value in settings.items():
+        if key != "observe":
+            params[base.param_names.index(key)] = float(value)
+    spec = replace(
+        base,
+        name=canonical(name),
+        params=tuple(params),
+        reference=Reference(NONE, NONE, NONE, NONE, "not measured"),
+        base=base.name,
+    )
+    if "observe" in settings:
+        observed = settings["observe"].split("+")
+        slots = tuple(base.state_names.index(v) for v in observed)
+        text = ", ".join(f"{v} scaled" for v in observed) + (", noise" if len(slots) == 1 else "")
+        spec = replace(spec, observed_slots=slots, observed=text)
+    return spec
+
+
+def _observe_columns(spec: TaskSpec) -> tuple[tuple[int, float, float, bool], ...] | None:
+    if spec.base and "observe" in parse(spec.name)[1]:
+        return tuple(
+            (s, spec.state_low[s], spec.state_high[s], s in spec.angle_slots)
+            for s in spec.observed_slots
+        )
+    return None
+
+
+def resolve(name: str) -> int:
+    """The id of a task or variant name (a variant gets the next free id on first use).
+
+    Raises:
+        ValueError: For an unknown task or a bad variant.
+    """
+    if name in _IDS:
+        return _IDS[name]
+    key = canonical(name)
+    if key not in _IDS:
+        from mtpg.envs.tasks import param_row
+
+        spec = variant_spec(key)
+        _VARIANTS.append(spec)
+        _TABLE.append(param_row(spec.params, TASK_NAMES.index(spec.base), _observe_columns(spec)))
+        _IDS[key] = len(TASKS) + len(_VARIANTS) - 1
+    _IDS[name] = _IDS[key]
+    return _IDS[key]
+
+
+def register(name: str) -> str:
+    """Registers a task or variant with Gymnasium (idempotent); returns its id.
+
+    ``gymnasium.make(register("CartPole[max_steps=500]"), action="native")`` then makes
+    the variant's environment.
+    """
+    import gymnasium
+
+    from mtpg.envs.registration import ENTRY_POINT
+
+    env_id = gym_id(name)
+    if env_id not in gymnasium.registry:
+        gymnasium.register(id=env_id, entry_point=ENTRY_POINT, kwargs={"task": canonical(name)})
+    return env_id
+
+
+def spec_of(task: int | str) -> TaskSpec:
+    """The spec of a task id or name, registered or variant."""
+    i = resolve(task) if isinstance(task, str) else int(task)
+    if not 0 <= i < len(TASKS) + len(_VARIANTS):
+        raise ValueError(f"unknown task id {i}; valid ids are 0..{n_tasks() - 1}")
+    return TASKS[i] if i < len(TASKS) else _VARIANTS[i - len(TASKS)]
+
+
+def n_tasks() -> int:
+    """Registered tasks plus the variants resolved so far in this process."""
+    return len(TASKS) + len(_VARIANTS)
+
+
+def task_params() -> np.ndarray:
+    """The parameter table of every id so far: ``TASK_PARAMS`` then one row per variant."""
+    from mtpg.envs.tasks import TASK_PARAMS, params_table
+
+    if not _VARIANTS:
+        return TASK_PARAMS
+    if len(_VARIANTS) not in _CACHE:
+        _CACHE.clear()
+        _CACHE[len(_VARIANTS)] = params_table([*TASK_PARAMS, *_TABLE])
+    return _CACHE[len(_VARIANTS)]

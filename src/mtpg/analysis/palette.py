@@ -30,6 +30,7 @@ def task_colour(task: str) -> str:
     Raises:
         ValueError: For an unknown task.
     """
-    if task not in TASK_COLOURS:
+    base = task.split("[", 1)[0]  # a variant has its base task's colour
+    if base not in TASK_COLOURS:
         raise ValueError(f"unknown task {task!r}; choose from {', '.join(TASK_NAMES)}")
-    return TASK_COLOURS[task]
+    return TASK_COLOURS[base]

@@ -41,12 +41,11 @@ def run(args: argparse.Namespace) -> int:
 
     from mtpg.analysis.replay import replay_task
     from mtpg.cli.cmd_evaluate import resolve_graph
+    from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
-    from mtpg.envs.core import TASK_NAMES
 
-    if args.task not in TASK_NAMES:
-        raise UsageError(f"unknown task {args.task!r}; choose from {', '.join(TASK_NAMES)}")
+    [args.task] = task_list(args.task, "--task")  # checked, spelled canonically
     if args.episodes < 1:
         raise UsageError(f"--episodes must be >= 1, got {args.episodes}")
     if args.out and not args.out.endswith(".npz"):

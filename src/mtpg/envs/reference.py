@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs.core import CARTCENTERING, TASK_NAMES
+from mtpg.envs.core import CARTCENTERING
 from mtpg.envs.protocol import (  # noqa: F401  (the seed bases live in protocol)
     N_TEST_EPISODES,
     RANDOM_SEED_BASE,
@@ -113,6 +113,39 @@ def measure_time_optimal_cartcentering(
 REFERENCE: tuple[Reference, ...] = tuple(t.reference for t in TASKS)
 
 
+_MEASURED: dict[str, Reference] = {}
+
+
+def reference_of(task: int | str) -> Reference:
+    """The reference scores of a task or variant.
+
+    A registered task's are its spec's. A variant's are measured on first use in the
+    process and kept: ``random`` / ``random_std`` by :func:`measure_random` on the variant
+    itself (its own dynamics and time limit), and ``best`` the base task's reference best,
+    with the source saying so (the variant's own best is not known; a changed time limit
+    may allow more).
+
+    Args:
+        task: A task id or name.
+    """
+    from mtpg.envs.variants import resolve, spec_of
+
+    spec = spec_of(resolve(task) if isinstance(task, str) else int(task))
+    if not spec.base:
+        return spec.reference
+    if spec.name not in _MEASURED:
+        mean, std = measure_random(resolve(spec.name))
+        base = spec_of(spec.base).reference
+        _MEASURED[spec.name] = Reference(
+            mean,
+            std,
+            base.best,
+            base.solved,
+            f"random measured; best of {spec.base}: {base.source}",
+        )
+    return _MEASURED[spec.name]
+
+
 def normalise(
     task: int, score: float | np.ndarray, best: float | None = None
 ) -> float | np.ndarray:
@@ -130,11 +163,13 @@ def normalise(
     Raises:
         ValueError: If ``best`` equals the random score.
     """
-    ref = REFERENCE[int(task)]
+    from mtpg.envs.variants import spec_of
+
+    ref = reference_of(int(task))
     top = ref.best if best is None else float(best)
     span = top - ref.random
     if span == 0:
-        raise ValueError(f"best equals the random score of {TASK_NAMES[int(task)]}")
+        raise ValueError(f"best equals the random score of {spec_of(int(task)).name}")
     if isinstance(score, np.ndarray):
         return (score - ref.random) / span
     return (float(score) - ref.random) / span

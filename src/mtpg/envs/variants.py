@@ -126,6 +126,44 @@ def canonical(text: str) -> str:
     return f"{base.name}[{';'.join(f'{k}={settings[k]}' for k in sorted(settings))}]"
 
 
+def from_table(table: dict) -> str:
+    """The canonical name of a ``[[task]]`` TOML table: ``base`` plus the variant's keys.
+
+    ``{"base": "Pendulum", "observe": ["theta"], "gravity": 9.81}`` (``observe`` a list of
+    state variables or a ``+``-joined string) gives ``"Pendulum[gravity=9.81;observe=theta]"``;
+    a table with ``base`` alone names the registered task.
+
+    Raises:
+        ValueError: Naming the fault (no ``base``, an unknown key, a bad value).
+    """
+    if not isinstance(table.get("base"), str):
+        raise ValueError("needs base = the name of a registered task")
+    items = []
+    for key, value in table.items():
+        if key == "base":
+            continue
+        if key == "observe" and isinstance(value, list):
+            value = "+".join(str(v) for v in value)
+        if isinstance(value, bool) or not isinstance(value, int | float | str):
+            raise ValueError(f"{key}: must be a number (observe: state variable names)")
+        items.append(f"{key}={value}")
+    return canonical(f"{table['base']}[{';'.join(items)}]" if items else table["base"])
+
+
+def known(name: str) -> bool:
+    """Whether a name is a registered task or a canonically spelled valid variant."""
+    try:
+        return canonical(name) == name
+    except ValueError:
+        return False
+
+
+def order_key(name: str) -> tuple[int, int, str]:
+    """Sorts task names by registry id, each variant after its base, variants by name."""
+    base = name.split("[", 1)[0]
+    return (TASK_NAMES.index(base), int(is_variant(name)), name)
+
+
 def gym_id(name: str) -> str:
     """The Gymnasium id of a task or variant, e.g. ``mtpg/CartPole-max_steps_500-v0``."""
     name = canonical(name)

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.envs.registry import PAPER_TASKS
-from mtpg.envs.variants import canonical, from_table, resolve
+from mtpg.envs.variants import canonical, from_tables, resolve
 from mtpg.limits import LIMITS
 
 
@@ -370,16 +370,12 @@ def _task_tables(data: dict[str, Any], toml_file: str | Path) -> dict[str, Any]:
     """Turns ``[[task]]`` tables into ``evaluation.tasks`` (one canonical name each)."""
     data = dict(data)
     tables = data.pop("task")
-    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
-        raise ConfigError(f"{toml_file}: task must be an array of tables ([[task]])")
     if "tasks" in data.get("evaluation", {}):
         raise ConfigError(f"{toml_file}: give the tasks as [[task]] or evaluation.tasks, not both")
-    names = []
-    for i, table in enumerate(tables):
-        try:
-            names.append(from_table(table))
-        except ValueError as exc:
-            raise ConfigError(f"{toml_file}: task[{i}]: {exc}") from None
+    try:
+        names = from_tables(tables)
+    except ValueError as exc:
+        raise ConfigError(f"{toml_file}: {exc}") from None
     data["evaluation"] = {**data.get("evaluation", {}), "tasks": names}
     return data
 

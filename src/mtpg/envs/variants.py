@@ -158,6 +158,23 @@ def known(name: str) -> bool:
         return False
 
 
+def from_tables(tables: object) -> list[str]:
+    """The canonical names of a TOML ``[[task]]`` array (see :func:`from_table`).
+
+    Raises:
+        ValueError: ``task[i]: ...`` naming the table at fault, or a non-array.
+    """
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables):
+        raise ValueError("task must be an array of tables ([[task]])")
+    names = []
+    for i, table in enumerate(tables):
+        try:
+            names.append(from_table(table))
+        except ValueError as exc:
+            raise ValueError(f"task[{i}]: {exc}") from None
+    return names
+
+
 def order_key(name: str) -> tuple[int, int, str]:
     """Sorts task names by registry id, each variant after its base, variants by name."""
     base = name.split("[", 1)[0]

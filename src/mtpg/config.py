@@ -14,8 +14,8 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
-from mtpg.envs.registry import PAPER_TASKS
-from mtpg.envs.variants import canonical, from_tables, resolve
+from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
+from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
 from mtpg.limits import LIMITS
 
 
@@ -151,6 +151,13 @@ class EvaluationConfig:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
         for name in self.tasks:
             _check(isinstance(name, str), "evaluation.tasks", "must hold task names", name)
+            if not is_variant(name):
+                _check(
+                    name in TASK_NAMES,
+                    "evaluation.tasks",
+                    f"must be among {', '.join(TASK_NAMES)}",
+                    name,
+                )
             try:
                 spelled = canonical(name)
             except ValueError as exc:

@@ -44,8 +44,12 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
+    from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.variants import known
 
-    [args.task] = task_list(args.task, "--task")  # checked, spelled canonically
+    [args.task] = task_list(args.task, "--task")  # a variant checked, spelled canonically
+    if not known(args.task):
+        raise UsageError(f"unknown task {args.task!r}; choose from {', '.join(TASK_NAMES)}")
     if args.episodes < 1:
         raise UsageError(f"--episodes must be >= 1, got {args.episodes}")
     if args.out and not args.out.endswith(".npz"):

@@ -63,7 +63,7 @@ def task_list(text: str, option: str = "--tasks") -> list[str]:
     """
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.variants import canonical
+    from mtpg.envs.variants import canonical, is_variant
 
     parts, depth, word = [], 0, ""
     for ch in text:
@@ -76,8 +76,8 @@ def task_list(text: str, option: str = "--tasks") -> list[str]:
     names = [t.strip() for t in [*parts, word] if t.strip()]
     if not names:
         raise UsageError(f"{option}: empty list; name at least one of {', '.join(TASK_NAMES)}")
-    try:
-        return [canonical(t) for t in names]
+    try:  # a plain unknown name is left to the configuration's check, which names the field
+        return [canonical(t) if is_variant(t) else t for t in names]
     except ValueError as exc:
         raise UsageError(f"{option}: {exc}") from None
 

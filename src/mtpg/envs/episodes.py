@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT
-from mtpg.envs.variants import n_tasks, spec_of
+from mtpg.envs.variants import id_ranges, spec_of, valid_id
 
 
 def _check_task(task: int) -> int:
     task = int(task)
-    if not 0 <= task < n_tasks():
-        raise ValueError(f"unknown task id {task}; valid ids are 0..{n_tasks() - 1}")
+    if not valid_id(task):
+        raise ValueError(f"unknown task id {task}; valid ids are {id_ranges()}")
     return task
 
 

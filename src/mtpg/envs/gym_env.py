@@ -23,7 +23,7 @@ from gymnasium import spaces
 from mtpg.envs.core import N_OBS, STATE_SIZE
 from mtpg.envs.episodes import sample_start
 from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.variants import n_tasks, resolve, spec_of, task_params
+from mtpg.envs.variants import resolve, spec_of, task_params, valid_id
 
 #: The action interfaces: the paper's pair, or the task's own single action.
 ACTIONS: tuple[str, ...] = ("paper", "native")
@@ -78,7 +78,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
 
     def __init__(self, task: int | str, render_mode: str | None = None, action: str = "paper"):
         task = resolve(task) if isinstance(task, str) else int(task)
-        if not 0 <= task < n_tasks():
+        if not valid_id(task):
             raise ValueError(f"unknown task id {task}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unsupported render_mode {render_mode!r}")

@@ -17,10 +17,10 @@ CartCentering's ``start_range``, keep their base value there).
 
 A variant's name is canonical (keys sorted, values normalised): :func:`canonical` turns any
 spelling into it, and the configuration stores it as the task's name. Its id is handed out
-when the name is first resolved in a process (:func:`resolve`), after the registry's: ids
-are process-local, names are what runs, checkpoints and graph files store. The reference
-scores of a variant are unknown (NaN) unless measured
-(:func:`mtpg.envs.reference.measure_random`).
+when the name is first resolved in a process (:func:`resolve`), from ``VARIANT_ID_BASE``
+(256) on: ids are process-local; names are what runs, checkpoints and graph files store.
+A variant's reference scores are measured on demand
+(:func:`mtpg.envs.reference.reference_of`).
 """
 
 from __future__ import annotations
@@ -35,6 +35,11 @@ from mtpg.envs.registry import TASK_NAMES, TASKS
 from mtpg.envs.taskspec import NONE, Reference, TaskSpec
 
 _NAME = re.compile(r"^(?P<base>[A-Za-z][A-Za-z0-9]*)\[(?P<body>[^\[\]]*)\]$")
+
+#: The first variant id: registered tasks keep 0.., variants get VARIANT_ID_BASE + k, so an
+#: id past the registry stays unknown until a task is registered under it, whatever
+#: variants a process has resolved (rows in between are padding whose kind has no branch).
+VARIANT_ID_BASE = 256
 
 _VARIANTS: list[TaskSpec] = []
 _IDS: dict[str, int] = {name: i for i, name in enumerate(TASK_NAMES)}
@@ -237,7 +242,7 @@ def resolve(name: str) -> int:
         spec = variant_spec(key)
         _VARIANTS.append(spec)
         _TABLE.append(param_row(spec.params, TASK_NAMES.index(spec.base), _observe_columns(spec)))
-        _IDS[key] = len(TASKS) + len(_VARIANTS) - 1
+        _IDS[key] = VARIANT_ID_BASE + len(_VARIANTS) - 1
     _IDS[name] = _IDS[key]
     return _IDS[key]
 
@@ -261,23 +266,32 @@ def register(name: str) -> str:
 def spec_of(task: int | str) -> TaskSpec:
     """The spec of a task id or name, registered or variant."""
     i = resolve(task) if isinstance(task, str) else int(task)
-    if not 0 <= i < len(TASKS) + len(_VARIANTS):
-        raise ValueError(f"unknown task id {i}; valid ids are 0..{n_tasks() - 1}")
-    return TASKS[i] if i < len(TASKS) else _VARIANTS[i - len(TASKS)]
+    if not valid_id(i):
+        raise ValueError(f"unknown task id {i}; valid ids are {id_ranges()}")
+    return TASKS[i] if i < len(TASKS) else _VARIANTS[i - VARIANT_ID_BASE]
 
 
-def n_tasks() -> int:
-    """Registered tasks plus the variants resolved so far in this process."""
-    return len(TASKS) + len(_VARIANTS)
+def valid_id(task: int) -> bool:
+    """Whether an id names a registered task or a variant resolved in this process."""
+    return 0 <= task < len(TASKS) or 0 <= task - VARIANT_ID_BASE < len(_VARIANTS)
+
+
+def id_ranges() -> str:
+    """The valid ids, as text (``0..5`` or ``0..5, 256..257``)."""
+    text = f"0..{len(TASKS) - 1}"
+    if _VARIANTS:
+        text += f", {VARIANT_ID_BASE}..{VARIANT_ID_BASE + len(_VARIANTS) - 1}"
+    return text
 
 
 def task_params() -> np.ndarray:
     """The parameter table of every id so far: ``TASK_PARAMS`` then one row per variant."""
-    from mtpg.envs.tasks import TASK_PARAMS, params_table
+    from mtpg.envs.tasks import TASK_PARAMS, param_row, params_table
 
     if not _VARIANTS:
         return TASK_PARAMS
     if len(_VARIANTS) not in _CACHE:
         _CACHE.clear()
-        _CACHE[len(_VARIANTS)] = params_table([*TASK_PARAMS, *_TABLE])
+        padding = [param_row((1.0, 0.0), -1)] * (VARIANT_ID_BASE - len(TASK_PARAMS))
+        _CACHE[len(_VARIANTS)] = params_table([*TASK_PARAMS, *padding, *_TABLE])
     return _CACHE[len(_VARIANTS)]

@@ -20,7 +20,7 @@ from numba.extending import intrinsic
 
 from mtpg.engine.ops import apply_op
 from mtpg.envs.core import STATE_SIZE
-from mtpg.envs.kernels import env_observe_row, env_reset, task_step
+from mtpg.envs.kernels import env_observe_row, env_reset, observe_kind, task_step
 from mtpg.envs.tasks import P_KIND
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
@@ -227,8 +227,9 @@ def run_jobs_queue(
             task = ep_task[e]
             p = params[task]  # the parameter row, taken once per episode
             kind = np.int64(p[P_KIND])  # the kernels playing it (the base task of a variant)
+            okind = observe_kind(p)  # and observing it
             env_reset(task, params, ep_start[e], state)
-            env_observe_row(kind, p, state, ep_noise[e, 0], obs)
+            env_observe_row(okind, p, state, ep_noise[e, 0], obs)
             counts[:] = 0
             total = 0.0
             t = 0
@@ -259,7 +260,7 @@ def run_jobs_queue(
                 t += 1
                 if terminated or truncated:
                     break
-                env_observe_row(kind, p, state, ep_noise[e, t], obs)
+                env_observe_row(okind, p, state, ep_noise[e, t], obs)
             out_return[j] = total
             out_steps[j] = t
             out_teams[j] = counts[0]

@@ -79,7 +79,19 @@ def env_observe(
         obs: Output array of at least two slots.
     """
     p = params[task]
-    env_observe_row(np.int64(p[P_KIND]), p, state, noise, obs)
+    env_observe_row(observe_kind(p), p, state, noise, obs)
+
+
+#: The observation kind of a row whose ``P_OBS`` column is set (a variant's observation).
+VARIANT_OBSERVATION = -2
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def observe_kind(p: np.ndarray) -> int:
+    """The observation kind of a parameter row: its base task id, or ``VARIANT_OBSERVATION``."""
+    if p[P_OBS] != 0.0:
+        return VARIANT_OBSERVATION
+    return np.int64(p[P_KIND])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -111,16 +123,15 @@ def task_observe(
     """The observation dispatch: writes the two inputs of a parameter row.
 
     Args:
-        kind: The row's base task id (``p[P_KIND]``).
+        kind: The row's observation kind, :func:`observe_kind` (its base task id, or
+            ``VARIANT_OBSERVATION``), taken once per episode.
         p: The parameter row.
         state: The current state array.
         noise: The episode's U[0, 1] noise value for this step.
         obs: Output array of at least two slots (NaN for an id without a branch).
     """
     task = kind
-    if p[P_OBS] != 0.0:
-        variant_observe(p, state, noise, obs)
-    elif task == CARTPOLE:
+    if task == CARTPOLE:
         cartpole.observe(p, state, noise, obs)
     elif task == ACROBOT:
         acrobot.observe(p, state, noise, obs)
@@ -130,6 +141,8 @@ def task_observe(
         pendulum.observe(p, state, noise, obs)
     elif task == MOUNTAINCAR or task == MOUNTAINCARCONTINUOUS:
         mountaincar.observe(p, state, noise, obs)
+    elif task == VARIANT_OBSERVATION:
+        variant_observe(p, state, noise, obs)
     else:
         obs[0] = np.nan
         obs[1] = np.nan
@@ -181,8 +194,8 @@ def env_observe_row(
 ) -> None:
     """:func:`env_observe` given the parameter row ``p = params[task]`` and its ``kind``.
 
-    The batch kernel takes the row and its kind (``p[P_KIND]``) once per episode: making
-    the row (an array view) at every step costs reference-count updates.
+    The batch kernel takes the row and its observation kind (:func:`observe_kind`) once per
+    episode: making the row (an array view) at every step costs reference-count updates.
     """
     task_observe(kind, p, state, noise, obs)
 

@@ -14,7 +14,8 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
+from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
 from mtpg.limits import LIMITS
 from mtpg.presets import ABLATIONS as ABLATIONS  # re-exported: presets live there
 from mtpg.presets import EXTENSIONS as EXTENSIONS
@@ -146,8 +147,10 @@ class TeamConfig:
 class EvaluationConfig:
     """Tasks, episodes and the test protocol (section 4.1 step 3, section 5)."""
 
-    tasks: tuple[str, ...] = TASK_NAMES
-    """Active tasks, by name; the power set of these drives selection."""
+    tasks: tuple[str, ...] = PAPER_TASKS
+    """Active tasks, by name: registered names or canonical variants such as
+    ``"CartPole[max_steps=500]"`` (``mtpg.envs.variants``); the power set of these drives
+    selection."""
     train_episodes: int = 5
     """Episodes per task on which each new root is evaluated (seeds 0..n-1)."""
     test_episodes: int = 100
@@ -171,12 +174,19 @@ class EvaluationConfig:
     def __post_init__(self) -> None:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
         for name in self.tasks:
-            _check(
-                name in TASK_NAMES,
-                "evaluation.tasks",
-                f"must be among {', '.join(TASK_NAMES)}",
-                name,
-            )
+            _check(isinstance(name, str), "evaluation.tasks", "must hold task names", name)
+            if not is_variant(name):
+                _check(
+                    name in TASK_NAMES,
+                    "evaluation.tasks",
+                    f"must be among {', '.join(TASK_NAMES)}",
+                    name,
+                )
+            try:
+                spelled = canonical(name)
+            except ValueError as exc:
+                raise ConfigError(f"evaluation.tasks: {exc}") from None
+            _check(spelled == name, "evaluation.tasks", f"must spell it {spelled!r}", name)
         _check(
             len(set(self.tasks)) == len(self.tasks),
             "evaluation.tasks",
@@ -199,8 +209,8 @@ class EvaluationConfig:
 
     @property
     def task_ids(self) -> tuple[int, ...]:
-        """Task ids of the active tasks, in configuration order."""
-        return tuple(TASK_NAMES.index(t) for t in self.tasks)
+        """Task ids of the active tasks, in configuration order (variants' ids resolved)."""
+        return tuple(resolve(t) for t in self.tasks)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -364,11 +374,27 @@ def build_config(
     config = merge(RunConfig(), PRESETS[preset])
     if toml_file is not None:
         data = read_toml(toml_file)
+        if "task" in data:
+            data = _task_tables(data, toml_file)
         try:
             config = merge(config, data)
         except ConfigError as exc:
             raise ConfigError(f"{toml_file}: {exc}") from exc
     return merge_overrides(config, overrides or [])
+
+
+def _task_tables(data: dict[str, Any], toml_file: str | Path) -> dict[str, Any]:
+    """Turns ``[[task]]`` tables into ``evaluation.tasks`` (one canonical name each)."""
+    data = dict(data)
+    tables = data.pop("task")
+    if "tasks" in data.get("evaluation", {}):
+        raise ConfigError(f"{toml_file}: give the tasks as [[task]] or evaluation.tasks, not both")
+    try:
+        names = from_tables(tables)
+    except ValueError as exc:
+        raise ConfigError(f"{toml_file}: {exc}") from None
+    data["evaluation"] = {**data.get("evaluation", {}), "tasks": names}
+    return data
 
 
 def _deep_update(into: dict[str, Any], data: dict[str, Any]) -> None:

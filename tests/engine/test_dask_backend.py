@@ -13,6 +13,7 @@ from mtpg.engine.batch import Episodes, evaluate_roots  # noqa: E402
 from mtpg.engine.compile import compile_population  # noqa: E402
 from mtpg.engine.dask_backend import DaskEvaluator, plan_batches  # noqa: E402
 from mtpg.engine.workload import tangled_population  # noqa: E402
+from mtpg.envs.variants import resolve  # noqa: E402
 from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer  # noqa: E402
 
 TINY = [
@@ -62,7 +63,9 @@ def test_batches_equal_the_local_engine(cluster, no_memory):
     pop = tangled_population(np.random.default_rng(3), 60, 150, 12, 20)
     cp = compile_population(pop)
     roots = sorted(pop.teams)[::2]
-    eps = Episodes.grid([0, 1, 2, 4], [0, 1, 2])
+    # a variant too: the workers never resolve its name, its row travels with the episodes
+    variant = resolve("Pendulum[max_steps=30;observe=theta_dot]")
+    eps = Episodes.grid([0, 1, 2, 4, variant], [0, 1, 2])
     want, w = evaluate_roots(cp, roots, eps, 1, no_memory)
     got, g = cluster.evaluate(cp, roots, eps, no_memory)
     assert np.array_equal(want, got)

@@ -11,10 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.analysis.inside import HIDDEN_VELOCITY, VELOCITY_NAME
 from mtpg.analysis.replay import Replay
-from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.tasks import ACTION_BOUND, OBSERVED, USES_CONTINUOUS
+from mtpg.envs.variants import spec_of
 
 
 def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
@@ -31,15 +29,15 @@ def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
         ``continuous`` (bool), ``x_label``, ``y_label``.
     """
     task = replay.task
-    task_id = TASK_NAMES.index(task)
-    continuous = bool(USES_CONTINUOUS[task_id])
+    spec = spec_of(task)
+    continuous = spec.continuous
     counts = replay.counts("visit")
     step_of_visit = np.repeat(np.arange(replay.n_steps), counts)
     last_visit = np.zeros(len(step_of_visit), dtype=bool)
     last_visit[replay["visit_offsets"][1:] - 1] = True
     x = replay["observation"][:, 0]
-    y = replay["hidden_state"][:, HIDDEN_VELOCITY[task]]
-    bound = float(ACTION_BOUND[task_id])
+    y = replay["hidden_state"][:, spec.velocity_slot]
+    bound = spec.bound
     action = np.clip(replay["a_c"], -bound, bound) if continuous else replay["a_d"] * 1.0
     teams = []
     for number in range(1, n_teams + 1):
@@ -57,6 +55,6 @@ def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
         "task": task,
         "teams": teams,
         "continuous": continuous,
-        "x_label": f"observed s[0] = {OBSERVED[task_id].split(',')[0]}",
-        "y_label": f"hidden {VELOCITY_NAME[task]}",
+        "x_label": f"observed s[0] = {spec.observed.split(',')[0]}",
+        "y_label": f"hidden {spec.velocity_name}",
     }

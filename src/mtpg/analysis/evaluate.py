@@ -8,9 +8,9 @@ import numpy as np
 
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
-from mtpg.envs.core import TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds
-from mtpg.envs.reference import REFERENCE, normalise
+from mtpg.envs.reference import normalise, reference_of
+from mtpg.envs.variants import resolve
 from mtpg.model.graph import Population
 
 
@@ -44,8 +44,8 @@ class TaskScore:
             "episodes": self.episodes,
             "normalised": self.normalised,
             "teams_per_decision": self.teams_per_decision,
-            "random": REFERENCE[TASK_NAMES.index(self.task)].random,
-            "reference_best": REFERENCE[TASK_NAMES.index(self.task)].best,
+            "random": reference_of(self.task).random,
+            "reference_best": reference_of(self.task).best,
         }
 
 
@@ -72,7 +72,7 @@ def evaluate_graph(
     Returns:
         Scores by task name, in the order given.
     """
-    ids = [TASK_NAMES.index(t) for t in tasks]
+    ids = [resolve(t) for t in tasks]
     table = Episodes.grid(ids, held_out_seeds(episodes, seed))
     returns, result = evaluate_roots(compile_population(pop), [root], table, workers, no_memory)
     returns = returns.reshape(len(ids), episodes)

@@ -9,17 +9,16 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.analysis.replay import Replay
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
+from mtpg.envs.variants import spec_of
 
-#: State slot of the hidden velocity each task's analysis tracks (section 6.3): CartPole
-#: the pole's angular velocity, Acrobot the first joint's (the paper's choice), the
-#: others their only velocity. The paper leaves CartPole's choice open; the pole's is
-#: the one its control depends on most.
-HIDDEN_VELOCITY: dict[str, int] = dict(zip(TASK_NAMES, (3, 2, 1, 1, 1, 1), strict=True))
+#: State slot of the hidden velocity each task's analysis tracks (section 6.3), each spec's
+#: ``velocity_slot``: CartPole the pole's angular velocity, Acrobot the first joint's (the
+#: paper's choice), the others their only velocity. The paper leaves CartPole's choice
+#: open; the pole's is the one its control depends on most.
+HIDDEN_VELOCITY: dict[str, int] = {t.name: t.velocity_slot for t in TASKS}
 #: Label of that variable.
-VELOCITY_NAME: dict[str, str] = dict(
-    zip(TASK_NAMES, ("theta_dot", "dtheta1", "v", "theta_dot", "velocity", "velocity"), strict=True)
-)
+VELOCITY_NAME: dict[str, str] = {t.name: t.velocity_name for t in TASKS}
 
 
 def final_teams(replay: Replay) -> np.ndarray:
@@ -204,7 +203,7 @@ def velocity_prediction(replay: Replay, episode: int = 0) -> dict[str, np.ndarra
         raise ValueError(f"episode {episode} has no memory recording in this replay")
     sl = replay.episode_slice(episode)
     task = replay.task
-    velocity = replay["hidden_state"][sl, HIDDEN_VELOCITY[task]]
+    velocity = replay["hidden_state"][sl, spec_of(task).velocity_slot]
     memory = replay["memory"][sl]
     col, r = best_register(velocity, memory)
     m = int(replay["n_memory"])
@@ -215,5 +214,5 @@ def velocity_prediction(replay: Replay, episode: int = 0) -> dict[str, np.ndarra
         "register": scale_pm1(reg) if reg is not None else np.zeros(len(velocity)),
         "r": r,
         "label": f"b{col // m + 1}.m{col % m}" if col >= 0 else "",
-        "variable": VELOCITY_NAME[task],
+        "variable": spec_of(task).velocity_name,
     }

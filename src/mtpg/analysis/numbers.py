@@ -104,12 +104,12 @@ def training_scores(run: RunData, path: Path) -> dict[str, float]:
     """
     from mtpg.engine.batch import Episodes, evaluate_roots
     from mtpg.engine.compile import compile_population
-    from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.variants import resolve
     from mtpg.io.serialize import load_graph
 
     pop, root, _ = load_graph(path)
     ev = run.config.evaluation
-    ids = [TASK_NAMES.index(t) for t in run.tasks]
+    ids = [resolve(t) for t in run.tasks]
     table = Episodes.grid(ids, training_seeds(ev.train_episodes))
     returns, _ = evaluate_roots(compile_population(pop), [root], table, 1, ev.no_memory)
     means = np.asarray(returns).reshape(len(ids), ev.train_episodes).mean(axis=1)

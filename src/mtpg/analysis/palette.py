@@ -7,15 +7,11 @@ videos); the section-5 figures of :mod:`mtpg.analysis.plots` colour runs, not ta
 from __future__ import annotations
 
 from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
 
-#: One colour per task, in task-id order (matplotlib's colour-blind-safe "tab10" picks).
-TASK_COLOURS: dict[str, str] = dict(
-    zip(
-        TASK_NAMES,
-        ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b"),
-        strict=True,
-    )
-)
+#: One colour per task, each spec's ``colour`` (the six are matplotlib's colour-blind-safe
+#: "tab10" picks).
+TASK_COLOURS: dict[str, str] = {t.name: t.colour for t in TASKS}
 #: Colours of the three atomic discrete actions (Fig. 10 style decompositions).
 ACTION_COLOURS: tuple[str, ...] = ("#0072b2", "#e69f00", "#cc79a7")
 #: Colormap of continuous actions.
@@ -34,6 +30,7 @@ def task_colour(task: str) -> str:
     Raises:
         ValueError: For an unknown task.
     """
-    if task not in TASK_COLOURS:
+    base = task.split("[", 1)[0]  # a variant has its base task's colour
+    if base not in TASK_COLOURS:
         raise ValueError(f"unknown task {task!r}; choose from {', '.join(TASK_NAMES)}")
-    return TASK_COLOURS[task]
+    return TASK_COLOURS[base]

@@ -60,8 +60,8 @@ from mtpg.analysis.graphinfo import effective_instruction_map, index_graph
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs import make_episodes
-from mtpg.envs.core import TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds
+from mtpg.envs.variants import canonical, known, resolve
 from mtpg.model.graph import Population
 
 SCHEMA_VERSION = 1
@@ -161,11 +161,12 @@ def replay_task(
     Returns:
         The replay.
     """
-    if task not in TASK_NAMES:
-        raise ValueError(f"unknown task {task!r}; choose from {', '.join(TASK_NAMES)}")
+    if not known(task):
+        canonical(task)  # raises, naming the fault
+        raise ValueError(f"write task {task!r} as {canonical(task)!r}")
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
-    task_id = TASK_NAMES.index(task)
+    task_id = resolve(task)
     cp = compile_population(pop)
     seeds = held_out_seeds(episodes, seed)
     starts, noise = make_episodes(np.full(episodes, task_id), seeds)

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 
 from mtpg.config import ABLATIONS, RunConfig, to_dict
-from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.reference import REFERENCE, normalise
+from mtpg.envs.reference import normalise, reference_of
+from mtpg.envs.variants import resolve
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_FILE
 
@@ -199,7 +199,7 @@ def normalise_scores(scores: dict[str, float], best: dict[str, float]) -> dict[s
     out = {}
     for task, score in scores.items():
         try:
-            out[task] = float(normalise(TASK_NAMES.index(task), score, best[task]))
+            out[task] = float(normalise(resolve(task), score, best[task]))
         except ValueError:  # best equals random play: the ratio is undefined
             out[task] = float("nan")
     return out
@@ -207,4 +207,4 @@ def normalise_scores(scores: dict[str, float], best: dict[str, float]) -> dict[s
 
 def reference_best(tasks: tuple[str, ...]) -> dict[str, float]:
     """The reference best score of each task (Fig. 6)."""
-    return {t: REFERENCE[TASK_NAMES.index(t)].best for t in tasks}
+    return {t: reference_of(t).best for t in tasks}

@@ -39,18 +39,20 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.page6 import build_analysis
     from mtpg.cli.cmd_evaluate import resolve_graph
+    from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.variants import known
 
     if args.episodes < 1:
         raise UsageError(f"--episodes must be >= 1, got {args.episodes}")
     target = Path(args.target)
     pop, root, meta, tasks = resolve_graph(target)
     if args.tasks:
-        tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+        tasks = task_list(args.tasks)
     for t in tasks + ([args.decompose_task] if args.decompose_task else []):
-        if t not in TASK_NAMES:
+        if not known(t):
             raise UsageError(f"unknown task {t!r}; choose from {', '.join(TASK_NAMES)}")
     if args.decompose_task and args.decompose_task not in tasks:
         raise UsageError(f"--decompose-task {args.decompose_task} is not among {tasks}")

@@ -63,9 +63,9 @@ def resolve_graph(target: Path):
         meta.setdefault("test_episodes", config.evaluation.test_episodes)
         return pop, root, meta, tasks
     pop, root, meta = load_graph(target)
-    from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.registry import PAPER_TASKS
 
-    return pop, root, meta, list(meta.get("tasks", TASK_NAMES))
+    return pop, root, meta, list(meta.get("tasks", PAPER_TASKS))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -77,6 +77,7 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.protocol import N_TEST_EPISODES
     from mtpg.envs.tasks import MAX_STEPS
+    from mtpg.envs.variants import known, spec_of
     from mtpg.limits import check_evaluation_fits
 
     pop, root, meta, tasks = resolve_graph(Path(args.target))
@@ -86,10 +87,11 @@ def run(args: argparse.Namespace) -> int:
     check_options(args)
     if args.tasks is not None:
         tasks = task_list(args.tasks)
-    unknown = [t for t in tasks if t not in TASK_NAMES]
+    unknown = [t for t in tasks if not known(t)]
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
-    check_evaluation_fits(len(tasks) * args.episodes, int(MAX_STEPS.max()))
+    longest = max([int(MAX_STEPS.max()), *(spec_of(t).max_steps for t in tasks)])
+    check_evaluation_fits(len(tasks) * args.episodes, longest)
     no_memory, memory = resolve_no_memory(args.memory, meta)
     scores = evaluate_graph(pop, root, tasks, args.episodes, args.seed, args.workers, no_memory)
     single = single_task_bests(Path(args.target), tasks)

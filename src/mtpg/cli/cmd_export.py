@@ -90,8 +90,11 @@ def choose_memory(choice: str, meta: dict, path: Path) -> tuple[bool, str]:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
+    from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.registry import PAPER_TASKS
+    from mtpg.envs.variants import known, resolve
     from mtpg.export.common import prepare
     from mtpg.io.serialize import load_graph
 
@@ -121,13 +124,13 @@ def run(args: argparse.Namespace) -> int:
                 raise UsageError(str(exc)) from exc
     if not args.bench:
         return 0
-    tasks = run_tasks or list(meta.get("tasks", TASK_NAMES))
+    tasks = run_tasks or list(meta.get("tasks", PAPER_TASKS))
     if args.tasks:
-        tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
-    unknown = [t for t in tasks if t not in TASK_NAMES]
+        tasks = task_list(args.tasks)
+    unknown = [t for t in tasks if not known(t)]
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
-    return _bench(args, graph, pop, root, [TASK_NAMES.index(t) for t in tasks])
+    return _bench(args, graph, pop, root, [resolve(t) for t in tasks])
 
 
 def _bench(args, graph, pop, root, task_ids: list[int]) -> int:

@@ -41,11 +41,14 @@ def run(args: argparse.Namespace) -> int:
 
     from mtpg.analysis.replay import replay_task
     from mtpg.cli.cmd_evaluate import resolve_graph
+    from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.variants import known
 
-    if args.task not in TASK_NAMES:
+    [args.task] = task_list(args.task, "--task")  # a variant checked, spelled canonically
+    if not known(args.task):
         raise UsageError(f"unknown task {args.task!r}; choose from {', '.join(TASK_NAMES)}")
     if args.episodes < 1:
         raise UsageError(f"--episodes must be >= 1, got {args.episodes}")

@@ -84,14 +84,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def task_list(text: str, option: str = "--tasks") -> list[str]:
-    """The names of a comma-separated list option, refusing an empty one."""
+    """The canonical names of a comma-separated list option, refusing an empty one.
+
+    Commas inside a variant's brackets do not split (``CartPole[max_steps=500],Pendulum``);
+    each name is checked and spelled canonically (``mtpg.envs.variants.canonical``).
+    """
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
+    from mtpg.envs.variants import canonical, is_variant
 
-    names = [t.strip() for t in text.split(",") if t.strip()]
+    parts, depth, word = [], 0, ""
+    for ch in text:
+        depth += {"[": 1, "]": -1}.get(ch, 0)
+        if ch == "," and depth <= 0:
+            parts.append(word)
+            word = ""
+        else:
+            word += ch
+    names = [t.strip() for t in [*parts, word] if t.strip()]
     if not names:
         raise UsageError(f"{option}: empty list; name at least one of {', '.join(TASK_NAMES)}")
-    return names
+    try:  # a plain unknown name is left to the configuration's check, which names the field
+        return [canonical(t) if is_variant(t) else t for t in names]
+    except ValueError as exc:
+        raise UsageError(f"{option}: {exc}") from None
 
 
 def overrides(args: argparse.Namespace) -> list[str]:

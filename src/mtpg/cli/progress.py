@@ -21,15 +21,29 @@ import time
 from pathlib import Path
 from typing import TextIO
 
-#: Short task labels for the status line (the header spells them out).
-SHORT = {
-    "CartPole": "CP",
-    "Acrobot": "AB",
-    "CartCentering": "CC",
-    "Pendulum": "PD",
-    "MountainCar": "MC",
-    "MountainCarContinuous": "MCC",
-}
+from mtpg.envs.registry import TASKS
+
+#: Short task labels for the status line (the header spells them out): each spec's
+#: ``short``.
+SHORT = {t.name: t.short for t in TASKS}
+
+
+def short_names(tasks: tuple[str, ...] | list[str]) -> dict[str, str]:
+    """The status line's label of each task.
+
+    A task's short name, a variant its base's; labels that repeat in the run are numbered
+    in run order (``CP1``, ``CP2``).
+    """
+    base = {t: SHORT[t.split("[", 1)[0]] for t in tasks}
+    labels = list(base.values())
+    out, seen = {}, dict.fromkeys(labels, 0)
+    for t in tasks:
+        if labels.count(base[t]) > 1:
+            seen[base[t]] += 1
+            out[t] = f"{base[t]}{seen[base[t]]}"
+        else:
+            out[t] = base[t]
+    return out
 
 
 def _fmt_rate(x: float) -> str:
@@ -86,6 +100,7 @@ class Progress:
     ) -> None:
         self.total = total
         self.tasks = tasks
+        self.short = short_names(tasks)
         self.stream = stream or sys.stderr
         self.live = self.stream.isatty() if live is None else live
         self.start = time.perf_counter()
@@ -121,7 +136,7 @@ class Progress:
 
     def header(self) -> str:
         """The lines that name every column of the status line."""
-        names = ", ".join(f"{SHORT[t]} = {t}" for t in self.tasks)
+        names = ", ".join(f"{self.short[t]} = {t}" for t in self.tasks)
         train = f"mean of {self.train_episodes} training episodes" if self.train_episodes else ""
         test = f"{self.test_episodes} held-out episodes" if self.test_episodes else "held-out"
         return (
@@ -174,10 +189,10 @@ class Progress:
         gen = int(row["generation"])
         took = self._durations[-1] if self._durations else float(row.get("t_total", 0.0))
         left = self.eta(gen)
-        train = " ".join(f"{SHORT[t]} {row[f'best_{t}']:.4g}" for t in self.tasks)
+        train = " ".join(f"{self.short[t]} {row[f'best_{t}']:.4g}" for t in self.tasks)
         if self.test is not None:
             g, scores = self.test
-            test = f"test@{g} " + " ".join(f"{SHORT[t]} {scores[t]:.4g}" for t in self.tasks)
+            test = f"test@{g} " + " ".join(f"{self.short[t]} {scores[t]:.4g}" for t in self.tasks)
         else:
             test = "test: none yet"
         return (

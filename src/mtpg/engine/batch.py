@@ -9,7 +9,8 @@ import numpy as np
 
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.kernels import run_jobs_parallel, run_jobs_queue
-from mtpg.envs import TASK_PARAMS, make_episodes
+from mtpg.envs import make_episodes
+from mtpg.envs.variants import task_params
 
 
 @dataclass(frozen=True)
@@ -21,12 +22,15 @@ class Episodes:
         seeds: int64 ``[n]`` episode seeds.
         starts: float64 ``[n, STATE_SIZE]``.
         noise: float64 ``[n, T + 1]``.
+        params: float64 ``[ids, N_PARAMS]``: the parameter table the task ids index
+            (``mtpg.envs.variants.task_params()`` when the table was drawn).
     """
 
     tasks: np.ndarray
     seeds: np.ndarray
     starts: np.ndarray
     noise: np.ndarray
+    params: np.ndarray
 
     @classmethod
     def make(cls, tasks: np.ndarray, seeds: np.ndarray) -> Episodes:
@@ -34,7 +38,9 @@ class Episodes:
         tasks = np.asarray(tasks, dtype=np.int64)
         seeds = np.asarray(seeds, dtype=np.int64)
         starts, noise = make_episodes(tasks, seeds)
-        return cls(tasks, seeds, np.ascontiguousarray(starts), np.ascontiguousarray(noise))
+        return cls(
+            tasks, seeds, np.ascontiguousarray(starts), np.ascontiguousarray(noise), task_params()
+        )
 
     @classmethod
     def grid(cls, tasks: list[int], seeds: list[int] | np.ndarray) -> Episodes:
@@ -104,7 +110,7 @@ def run_jobs(
         episodes.tasks,
         episodes.starts,
         episodes.noise,
-        TASK_PARAMS,
+        episodes.params,
         no_memory,
         out.returns,
         out.steps,

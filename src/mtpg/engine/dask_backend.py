@@ -34,7 +34,6 @@ from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.evaluator import BackendLost
 from mtpg.engine.kernels import run_jobs_queue
-from mtpg.envs import TASK_PARAMS
 
 #: Batches per worker thread: enough to balance roots of uneven cost, few enough that the
 #: scheduler's cost per task (about 1.5 ms) stays negligible. Measured on paper-sized
@@ -86,7 +85,7 @@ def play_batch(
     graph: tuple,
     job_roots: np.ndarray,
     job_eps: np.ndarray,
-    table: tuple[np.ndarray, np.ndarray, np.ndarray],
+    table: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
     no_memory: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Plays one batch of jobs serially (runs on a worker).
@@ -95,7 +94,8 @@ def play_batch(
         graph: :func:`graph_arrays` of the compiled population.
         job_roots: int64 dense team index of each job.
         job_eps: int64 episode row of each job.
-        table: The episode table's ``tasks``, ``starts`` and ``noise`` arrays.
+        table: The episode table's ``tasks``, ``starts``, ``noise`` and ``params`` arrays
+            (the parameter table travels with the episodes, variants' rows included).
         no_memory: The memory ablation switch.
 
     Returns:
@@ -104,7 +104,7 @@ def play_batch(
     n = len(job_roots)
     out = (np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
     queue = np.zeros(1, dtype=np.int64)
-    run_jobs_queue(queue, 1, job_roots, job_eps, *table, TASK_PARAMS, no_memory, *out, *graph)
+    run_jobs_queue(queue, 1, job_roots, job_eps, *table, no_memory, *out, *graph)
     return out
 
 
@@ -305,7 +305,7 @@ class DaskEvaluator:
         if key not in self._tables:
             if len(self._tables) >= TABLES_KEPT:
                 self._tables.pop(next(iter(self._tables))).release()
-            arrays = (episodes.tasks, episodes.starts, episodes.noise)
+            arrays = (episodes.tasks, episodes.starts, episodes.noise, episodes.params)
             [self._tables[key]] = self.client.scatter([arrays], broadcast=True, hash=False)
         return self._tables[key]
 

@@ -169,8 +169,11 @@ def reference_episode(
     Returns:
         ``(return, steps)``.
     """
-    from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
+    from mtpg.envs import env_observe, env_reset, env_step
     from mtpg.envs.core import STATE_SIZE
+    from mtpg.envs.variants import task_params
+
+    TASK_PARAMS = task_params()  # noqa: N806  (variants' rows included)
 
     agent.reset()
     state = np.zeros(STATE_SIZE)

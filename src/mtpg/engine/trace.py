@@ -17,8 +17,10 @@ from numba import njit
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.kernels import new_workspace
 from mtpg.engine.ops import apply_op
-from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
+from mtpg.envs import env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE
+from mtpg.envs.tasks import TASK_PARAMS
+from mtpg.envs.variants import task_params
 from mtpg.model.instructions import CONDITIONAL_OPS, N_CONSTANTS, UNARY_OPS
 
 _FIRST_UNARY = min(UNARY_OPS)
@@ -269,7 +271,7 @@ def trace_episode(
     out = trace_kernel(
         cp.team_index(root_id),
         task,
-        TASK_PARAMS,
+        task_params(),
         np.ascontiguousarray(start, dtype=np.float64),
         np.ascontiguousarray(noise, dtype=np.float64),
         np.zeros((0, 2)),

@@ -11,28 +11,16 @@ import math
 import numpy as np
 from numba import njit
 
+from mtpg.envs import registry
 from mtpg.envs._util import clip, clip_obs, continuous_action
 
 MAX_STEPS, MAX_TORQUE, DT, LINK_LENGTH_1, LINK_MASS_1, LINK_MASS_2 = range(6)
 LINK_COM_POS_1, LINK_COM_POS_2, LINK_MOI, GRAVITY, MAX_VEL_1, MAX_VEL_2 = range(6, 12)
 
-#: Parameter row, in column order.
-PARAMS: tuple[float, ...] = (
-    500.0,  # time limit (Acrobot-v1)
-    1.0,  # torque bound [N m] (Gymnasium's discrete torques are -1, 0, +1)
-    0.2,  # dt [s], one RK4 step
-    1.0,  # length of link 1 [m]
-    1.0,  # mass of link 1 [kg]
-    1.0,  # mass of link 2 [kg]
-    0.5,  # centre of mass of link 1 [m]
-    0.5,  # centre of mass of link 2 [m]
-    1.0,  # moment of inertia of both links
-    9.8,  # gravity
-    4 * math.pi,  # |dtheta1| bound
-    9 * math.pi,  # |dtheta2| bound
-)
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+PARAMS: tuple[float, ...] = registry.ACROBOT.params
 
-STATE_DIM = 4
+STATE_DIM = registry.ACROBOT.state_dim
 
 _PI = math.pi
 

@@ -15,25 +15,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from mtpg.envs import registry
 from mtpg.envs._util import bang_bang_force, clip, clip_obs
 from mtpg.envs.core import PREV_FORCE_SLOT, STEP_SLOT
 
 MAX_STEPS, FORCE, TAU, MASS, MAX_SPEED, X_BOUND, CAPTURE, START_RANGE, TIME_COST = range(9)
 
-#: Parameter row, in column order.
-PARAMS: tuple[float, ...] = (
-    500.0,  # time limit (10 s)
-    1.0,  # force magnitude [N]
-    0.02,  # tau [s]
-    2.0,  # cart mass [kg]
-    6.0,  # |v| bound [m/s]
-    1.5,  # |x| bound: the episode ends beyond it [m]
-    0.01,  # capture box half-width, for both x and v
-    0.75,  # start x, v ~ U[-0.75, 0.75]
-    0.1,  # weight of the elapsed-time term of the terminal penalty
-)
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+PARAMS: tuple[float, ...] = registry.CARTCENTERING.params
 
-STATE_DIM = 2
+STATE_DIM = registry.CARTCENTERING.state_dim
 
 
 def is_captured(x: float, v: float) -> bool:

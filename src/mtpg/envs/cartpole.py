@@ -7,32 +7,21 @@ terminating step included.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
+from mtpg.envs import registry
 from mtpg.envs._util import bang_bang_force, clip_obs
 from mtpg.envs.core import PREV_FORCE_SLOT
 
 # Parameter columns (columns 0 and 1 are common to all tasks, see ``mtpg.envs.tasks``).
 MAX_STEPS, FORCE, TAU, GRAVITY, MASSCART, MASSPOLE, LENGTH, X_THRESHOLD, THETA_THRESHOLD = range(9)
 
-#: Parameter row, in column order.
-PARAMS: tuple[float, ...] = (
-    200.0,  # time limit (as CartPole-v0)
-    10.0,  # force magnitude [N]
-    0.02,  # tau [s]
-    9.8,  # gravity
-    1.0,  # cart mass [kg]
-    0.1,  # pole mass [kg]
-    0.5,  # half the pole length [m]
-    2.4,  # |x| failure threshold [m]
-    12 * 2 * math.pi / 360,  # |theta| failure threshold [rad]
-)
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+PARAMS: tuple[float, ...] = registry.CARTPOLE.params
 
 #: Number of hidden physical state variables (x, x_dot, theta, theta_dot).
-STATE_DIM = 4
+STATE_DIM = registry.CARTPOLE.state_dim
 
 
 def sample_start(rng: np.random.Generator) -> np.ndarray:

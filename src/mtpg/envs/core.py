@@ -1,7 +1,8 @@
 """The task contract shared by the environment kernels and the execution engine.
 
-A task is an integer id plus data: one row of a float64 parameter table, a time limit and
-the action it reads. Task state lives in a flat float64 array of ``STATE_SIZE`` slots:
+A task is an integer id plus data (its :class:`~mtpg.envs.taskspec.TaskSpec` in
+:mod:`mtpg.envs.registry`): one row of a float64 parameter table, a time limit and the
+action it reads. Task state lives in a flat float64 array of ``STATE_SIZE`` slots:
 
 ======  ================================================================
 slot    meaning
@@ -14,17 +15,17 @@ slot    meaning
 
 from __future__ import annotations
 
-#: Task names in id order; the id of a task is its index here.
-TASK_NAMES: tuple[str, ...] = (
-    "CartPole",
-    "Acrobot",
-    "CartCentering",
-    "Pendulum",
-    "MountainCar",
-    "MountainCarContinuous",
-)
+from mtpg.envs.registry import TASK_NAMES, task_id
 
-CARTPOLE, ACROBOT, CARTCENTERING, PENDULUM, MOUNTAINCAR, MOUNTAINCARCONTINUOUS = range(6)
+# The ids the compiled dispatch (mtpg.envs.kernels.task_step) branches on.
+CARTPOLE = task_id("CartPole")
+ACROBOT = task_id("Acrobot")
+CARTCENTERING = task_id("CartCentering")
+PENDULUM = task_id("Pendulum")
+MOUNTAINCAR = task_id("MountainCar")
+MOUNTAINCARCONTINUOUS = task_id("MountainCarContinuous")
+#: Number of registered tasks.
+N_TASKS = len(TASK_NAMES)
 
 #: Number of float64 slots of a task state array.
 STATE_SIZE = 6

@@ -4,24 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
-from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT, TASK_NAMES
-from mtpg.envs.tasks import MAX_STEPS, P_FORCE, TASK_PARAMS
-
-_SAMPLERS = (
-    cartpole.sample_start,
-    acrobot.sample_start,
-    cartcentering.sample_start,
-    pendulum.sample_start,
-    mountaincar.sample_start,
-    mountaincar.sample_start,
-)
+from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT
+from mtpg.envs.variants import id_ranges, spec_of, valid_id
 
 
 def _check_task(task: int) -> int:
     task = int(task)
-    if not 0 <= task < len(TASK_NAMES):
-        raise ValueError(f"unknown task id {task}; valid ids are 0..{len(TASK_NAMES) - 1}")
+    if not valid_id(task):
+        raise ValueError(f"unknown task id {task}; valid ids are {id_ranges()}")
     return task
 
 
@@ -41,10 +31,11 @@ def sample_start(task: int, rng: np.random.Generator) -> np.ndarray:
         (``+F``) and the step count (0).
     """
     task = _check_task(task)
-    phys = np.asarray(_SAMPLERS[task](rng), dtype=np.float64)
+    spec = spec_of(task)
+    phys = np.asarray(spec.kernel("sample_start")(rng), dtype=np.float64)
     start = np.zeros(STATE_SIZE, dtype=np.float64)
     start[: phys.shape[0]] = phys
-    start[PREV_FORCE_SLOT] = TASK_PARAMS[task, P_FORCE]
+    start[PREV_FORCE_SLOT] = spec.params[1]
     start[STEP_SLOT] = 0.0
     return start
 
@@ -74,13 +65,14 @@ def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.
     n = tasks.shape[0]
     for task in tasks:
         _check_task(task)
-    width = int(MAX_STEPS[tasks.astype(np.int64)].max()) + 1 if n else 1
+    limits = {int(t): spec_of(int(t)).max_steps for t in set(tasks.tolist())}
+    width = max(limits.values()) + 1 if n else 1
     starts = np.zeros((n, STATE_SIZE), dtype=np.float64)
     noise = np.zeros((n, width), dtype=np.float64)
     for i in range(n):
         task = _check_task(tasks[i])
         rng = np.random.default_rng(int(seeds[i]))
         starts[i] = sample_start(task, rng)
-        k = int(MAX_STEPS[task]) + 1
+        k = limits[task] + 1
         noise[i, :k] = rng.random(k)
     return starts, noise

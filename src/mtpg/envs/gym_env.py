@@ -1,7 +1,9 @@
-"""A Gymnasium environment over the compiled kernels, one class for all six tasks.
+"""A Gymnasium environment over the compiled kernels, one class for every task.
 
 ``gymnasium.make("mtpg/<Task>-v0")`` builds ``MtpgEnv(task=<id>)`` (see
-``mtpg.envs.registration``). The environment uses exactly the kernels of the execution
+``mtpg.envs.registration``); ``gymnasium.make("mtpg/<Task>-v0", action="native")`` gives
+the task's own single action instead of the paper's pair, for libraries that train on one
+``Discrete`` or ``Box`` action. The environment uses exactly the kernels of the execution
 engine and the episode draws of ``make_episodes``: ``reset(seed=s)`` seeds the generator
 ``np.random.default_rng(s)`` (Gymnasium's ``np_random``), draws the start state with
 ``sample_start`` and then one noise value per observation.
@@ -18,10 +20,13 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from mtpg.envs.core import N_OBS, STATE_SIZE, TASK_NAMES
+from mtpg.envs.core import N_OBS, STATE_SIZE
 from mtpg.envs.episodes import sample_start
 from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.tasks import STATE_DIMS, TASK_PARAMS, USES_CONTINUOUS
+from mtpg.envs.variants import resolve, spec_of, task_params, valid_id
+
+#: The action interfaces: the paper's pair, or the task's own single action.
+ACTIONS: tuple[str, ...] = ("paper", "native")
 
 
 def _parse_action(action: Any) -> tuple[int, float]:
@@ -32,35 +37,65 @@ def _parse_action(action: Any) -> tuple[int, float]:
     return a_d, a_c
 
 
+def paper_action_space() -> spaces.Tuple:
+    """The paper's pair: ``Tuple(Discrete(3), Box(-inf, inf, (1,), float64))``."""
+    return spaces.Tuple((spaces.Discrete(3), spaces.Box(-np.inf, np.inf, (1,), dtype=np.float64)))
+
+
+def native_action_space(task: int) -> spaces.Space:
+    """The task's own action: ``Discrete(3)``, or ``Box(-bound, bound, (1,), float64)``."""
+    spec = spec_of(task)
+    if spec.continuous:
+        return spaces.Box(-spec.bound, spec.bound, (1,), dtype=np.float64)
+    return spaces.Discrete(3)
+
+
+def native_to_pair(task: int, action: Any) -> tuple[int, float]:
+    """The paper's ``(a_d, a_c)`` of a native action (the unread one neutral: 1 or 0.0)."""
+    if spec_of(task).continuous:
+        return 1, float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
+    return int(np.asarray(action).reshape(-1)[0]), 0.0
+
+
 class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
     """One of the six partially-observable tasks with the paper's interface.
 
-    Observation: ``Box(-1, 1, (2,), float64)``. Action: ``Tuple(Discrete(3),
-    Box(-inf, inf, (1,), float64))``; the task reads one of the two and ignores the other.
-    The time limit is built in (``truncated``), so no ``TimeLimit`` wrapper is needed.
+    Observation: ``Box(-1, 1, (2,), float64)``. Action (``action="paper"``):
+    ``Tuple(Discrete(3), Box(-inf, inf, (1,), float64))``; the task reads one of the two and
+    ignores the other. With ``action="native"``: the one the task reads, ``Discrete(3)`` or
+    ``Box(-bound, bound, (1,), float64)`` (:func:`native_action_space`); the dynamics are
+    the same. The time limit is built in (``truncated``), so no ``TimeLimit`` wrapper is
+    needed.
 
     Args:
-        task: The task id (index into ``TASK_NAMES``).
+        task: The task id (index into ``TASK_NAMES``), or a task or variant name
+            (``"CartPole[max_steps=500]"``, see :mod:`mtpg.envs.variants`).
         render_mode: None or ``"rgb_array"``.
+        action: ``"paper"`` or ``"native"``.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
 
-    def __init__(self, task: int, render_mode: str | None = None):
-        if not 0 <= int(task) < len(TASK_NAMES):
+    def __init__(self, task: int | str, render_mode: str | None = None, action: str = "paper"):
+        task = resolve(task) if isinstance(task, str) else int(task)
+        if not valid_id(task):
             raise ValueError(f"unknown task id {task}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unsupported render_mode {render_mode!r}")
+        if action not in ACTIONS:
+            raise ValueError(f"action must be one of {', '.join(ACTIONS)}, got {action!r}")
         self._task = int(task)
+        self._native = action == "native"
         self.render_mode = render_mode
         self.observation_space = spaces.Box(-1.0, 1.0, (N_OBS,), dtype=np.float64)
-        self.action_space = spaces.Tuple(
-            (spaces.Discrete(3), spaces.Box(-np.inf, np.inf, (1,), dtype=np.float64))
+        self.action_space = (
+            native_action_space(self._task) if self._native else paper_action_space()
         )
-        self._params = TASK_PARAMS
+        self._params = task_params()
         self._state = np.zeros(STATE_SIZE, dtype=np.float64)
         self._obs = np.zeros(N_OBS, dtype=np.float64)
-        self._dim = int(STATE_DIMS[self._task])
+        self._dim = spec_of(self._task).state_dim
+        self._continuous = spec_of(self._task).continuous
         self._last_action = 0.0
         self._renderer: Any = None
 
@@ -96,14 +131,14 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         """Advances the task by one step.
 
         Args:
-            action: ``(a_d, a_c)``.
+            action: ``(a_d, a_c)``, or the native action.
 
         Returns:
             (observation, reward, terminated, truncated, info).
         """
-        a_d, a_c = _parse_action(action)
+        a_d, a_c = native_to_pair(self._task, action) if self._native else _parse_action(action)
         reward, terminated, truncated = env_step(self._task, self._params, self._state, a_d, a_c)
-        self._last_action = a_c if USES_CONTINUOUS[self._task] else 0.0
+        self._last_action = a_c if self._continuous else 0.0
         return self._observe(), float(reward), bool(terminated), bool(truncated), self._info()
 
     def render(self) -> np.ndarray | None:

@@ -1,8 +1,18 @@
 """The compiled task interface the execution engine calls: reset, observe and step.
 
-Each function dispatches on the task id with an if-chain to the task modules. State lives
-in a float64 array of ``STATE_SIZE`` slots (see ``mtpg.envs.core``); parameters are
-``TASK_PARAMS`` (see ``mtpg.envs.tasks``).
+:func:`task_observe` and :func:`task_step` are the one dispatch on the task id: an if-chain
+to the task modules, with a branch per task of the registry (:mod:`mtpg.envs.registry`).
+Every kernel (these, the batch kernel of training, the traced kernel) reaches the task
+modules through them. An id without a branch observes NaN and ends its episode at once
+with a NaN reward, so a task missing from the chain cannot pass for another task
+(``tests/envs/test_dispatch.py`` plays every registered task through every kernel).
+
+The dispatch branches on a row's ``kind`` column (``P_KIND``): a registered task's own id,
+or a variant's base task id (:mod:`mtpg.envs.variants`), so a variant runs its base task's
+kernels on its own parameter row; a row whose ``P_OBS`` column is set is observed by
+:func:`variant_observe`. State lives in a float64 array of ``STATE_SIZE`` slots (see
+``mtpg.envs.core``); parameters are rows of ``TASK_PARAMS`` (see ``mtpg.envs.tasks``) or of
+``mtpg.envs.variants.task_params()``.
 
 Action conventions: a non-finite ``a_c`` is treated as 0 and then clipped to the task's
 bound; an ``a_d`` outside {0, 1, 2} is treated as 1 ("repeat the previous force" in
@@ -15,17 +25,28 @@ import numpy as np
 from numba import njit
 
 from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
+from mtpg.envs._util import clip_obs
 from mtpg.envs.core import (
     ACROBOT,
     CARTCENTERING,
     CARTPOLE,
     MOUNTAINCAR,
+    MOUNTAINCARCONTINUOUS,
     PENDULUM,
     PREV_FORCE_SLOT,
     STATE_SIZE,
     STEP_SLOT,
 )
-from mtpg.envs.tasks import P_FORCE, P_MAX_STEPS
+from mtpg.envs.tasks import (
+    P_FORCE,
+    P_KIND,
+    P_MAX_STEPS,
+    P_OBS,
+    P_OBS_HI,
+    P_OBS_LO,
+    P_OBS_SLOT,
+    P_OBS_WRAP,
+)
 
 
 @njit(cache=True, error_model="numpy")
@@ -57,18 +78,59 @@ def env_observe(
         noise: The episode's U[0, 1] noise value for this step (used by one-input tasks).
         obs: Output array of at least two slots.
     """
-    env_observe_row(task, params[task], state, noise, obs)
+    p = params[task]
+    env_observe_row(observe_kind(p), p, state, noise, obs)
 
 
-@njit(cache=True, error_model="numpy")
-def env_observe_row(
-    task: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
-) -> None:
-    """:func:`env_observe` given the task's parameter row ``p = params[task]``.
+#: The observation kind of a row whose ``P_OBS`` column is set (a variant's observation).
+VARIANT_OBSERVATION = -2
 
-    The batch kernel takes the row once per episode: making it (an array view) at every
-    step costs reference-count updates.
+
+@njit(cache=True, error_model="numpy", inline="always")
+def observe_kind(p: np.ndarray) -> int:
+    """The observation kind of a parameter row: its base task id, or ``VARIANT_OBSERVATION``."""
+    if p[P_OBS] != 0.0:
+        return VARIANT_OBSERVATION
+    return np.int64(p[P_KIND])
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def variant_observe(p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray) -> None:
+    """A variant's observation: each input a state slot scaled to [-1, 1], or the noise.
+
+    Args:
+        p: The variant's parameter row (columns ``P_OBS_*``).
+        state: The current state array.
+        noise: The episode's U[0, 1] noise value for this step.
+        obs: Output array of at least two slots.
     """
+    for i in range(2):
+        slot = np.int64(p[P_OBS_SLOT + i])
+        if slot < 0:
+            obs[i] = clip_obs(noise)
+        else:
+            x = state[slot]
+            if p[P_OBS_WRAP + i] != 0.0:
+                x = pendulum.angle_normalize(x)
+            lo = p[P_OBS_LO + i]
+            obs[i] = clip_obs(2.0 * (x - lo) / (p[P_OBS_HI + i] - lo) - 1.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def task_observe(
+    kind: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
+) -> None:
+    """The observation dispatch: writes the two inputs of a parameter row.
+
+    Args:
+        kind: The row's observation kind, :func:`observe_kind` (its base task id, or
+            ``VARIANT_OBSERVATION``), taken once per episode.
+        p: The parameter row.
+        state: The current state array.
+        noise: The episode's U[0, 1] noise value for this step.
+        obs: Output array of at least two slots (NaN for an id without a branch).
+    """
+    task = kind
     if task == CARTPOLE:
         cartpole.observe(p, state, noise, obs)
     elif task == ACROBOT:
@@ -77,8 +139,65 @@ def env_observe_row(
         cartcentering.observe(p, state, noise, obs)
     elif task == PENDULUM:
         pendulum.observe(p, state, noise, obs)
-    else:
+    elif task == MOUNTAINCAR or task == MOUNTAINCARCONTINUOUS:
         mountaincar.observe(p, state, noise, obs)
+    elif task == VARIANT_OBSERVATION:
+        variant_observe(p, state, noise, obs)
+    else:
+        obs[0] = np.nan
+        obs[1] = np.nan
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def task_step(
+    kind: int, p: np.ndarray, state: np.ndarray, a_d: int, a_c: float
+) -> tuple[float, bool, bool]:
+    """The step dispatch: advances the task of a parameter row by one step in place.
+
+    Inlined into its callers (``inline="always"``), so that the batch kernel's episode
+    loop pays no call passing the state and parameter arrays (each such call costs atomic
+    reference-count updates).
+
+    Args:
+        kind: The row's base task id (``p[P_KIND]``): which kernels play it.
+        p: The parameter row.
+        state: The state array, updated in place.
+        a_d: The discrete action (read by the discrete tasks).
+        a_c: The continuous action (read by the continuous tasks).
+
+    Returns:
+        (reward, terminated, truncated); an id without a branch gives (NaN, True, False).
+    """
+    task = kind
+    state[STEP_SLOT] += 1.0
+    if task == CARTPOLE:
+        reward, terminated = cartpole.step(p, state, a_d)
+    elif task == ACROBOT:
+        reward, terminated = acrobot.step(p, state, a_c)
+    elif task == CARTCENTERING:
+        reward, terminated = cartcentering.step(p, state, a_d)
+    elif task == PENDULUM:
+        reward, terminated = pendulum.step(p, state, a_c)
+    elif task == MOUNTAINCAR:
+        reward, terminated = mountaincar.step_discrete(p, state, a_d)
+    elif task == MOUNTAINCARCONTINUOUS:
+        reward, terminated = mountaincar.step_continuous(p, state, a_c)
+    else:
+        reward, terminated = np.nan, True
+    truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]
+    return reward, terminated, truncated
+
+
+@njit(cache=True, error_model="numpy")
+def env_observe_row(
+    kind: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
+) -> None:
+    """:func:`env_observe` given the parameter row ``p = params[task]`` and its ``kind``.
+
+    The batch kernel takes the row and its observation kind (:func:`observe_kind`) once per
+    episode: making the row (an array view) at every step costs reference-count updates.
+    """
+    task_observe(kind, p, state, noise, obs)
 
 
 @njit(cache=True, error_model="numpy")
@@ -97,24 +216,6 @@ def env_step(
     Returns:
         (reward, terminated, truncated); truncated is True when the step count reaches the
         task's time limit without termination.
-
-    The batch kernel (:func:`mtpg.engine.kernels.run_jobs_queue`) repeats this dispatch
-    in its episode loop, for speed; the two must stay the same (the engine's parity tests
-    play every task through both).
     """
     p = params[task]
-    state[STEP_SLOT] += 1.0
-    if task == CARTPOLE:
-        reward, terminated = cartpole.step(p, state, a_d)
-    elif task == ACROBOT:
-        reward, terminated = acrobot.step(p, state, a_c)
-    elif task == CARTCENTERING:
-        reward, terminated = cartcentering.step(p, state, a_d)
-    elif task == PENDULUM:
-        reward, terminated = pendulum.step(p, state, a_c)
-    elif task == MOUNTAINCAR:
-        reward, terminated = mountaincar.step_discrete(p, state, a_d)
-    else:
-        reward, terminated = mountaincar.step_continuous(p, state, a_c)
-    truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]
-    return reward, terminated, truncated
+    return task_step(np.int64(p[P_KIND]), p, state, a_d, a_c)

@@ -15,42 +15,19 @@ import math
 import numpy as np
 from numba import njit
 
+from mtpg.envs import registry
 from mtpg.envs._util import clip_obs, continuous_action
 
 MAX_STEPS, FORCE, GRAVITY, MIN_POSITION, MAX_POSITION, MAX_SPEED = range(6)
 GOAL_POSITION, GOAL_VELOCITY, GOAL_REWARD, ACTION_COST, POWER = range(6, 11)
 
 #: Parameter row of MountainCar, in column order.
-PARAMS_DISCRETE: tuple[float, ...] = (
-    200.0,  # time limit
-    0.001,  # force of a push
-    0.0025,  # gravity
-    -1.2,  # minimum position
-    0.6,  # maximum position
-    0.07,  # |velocity| bound
-    0.5,  # goal position
-    0.0,  # goal velocity
-    0.0,  # goal reward (unused)
-    0.0,  # action cost (unused)
-    0.0,  # engine power (unused)
-)
+PARAMS_DISCRETE: tuple[float, ...] = registry.MOUNTAINCAR.params
 
 #: Parameter row of MountainCarContinuous, in column order.
-PARAMS_CONTINUOUS: tuple[float, ...] = (
-    999.0,  # time limit
-    1.0,  # force bound; the force is scaled by the power below
-    0.0025,  # gravity
-    -1.2,  # minimum position
-    0.6,  # maximum position
-    0.07,  # |velocity| bound
-    0.45,  # goal position
-    0.0,  # goal velocity
-    100.0,  # reward on reaching the goal
-    0.1,  # cost per squared (clipped) force
-    0.0015,  # engine power: the velocity change is force * power
-)
+PARAMS_CONTINUOUS: tuple[float, ...] = registry.MOUNTAINCARCONTINUOUS.params
 
-STATE_DIM = 2
+STATE_DIM = registry.MOUNTAINCAR.state_dim
 
 
 def sample_start(rng: np.random.Generator) -> np.ndarray:

@@ -11,22 +11,15 @@ import math
 import numpy as np
 from numba import njit
 
+from mtpg.envs import registry
 from mtpg.envs._util import clip, clip_obs, continuous_action
 
 MAX_STEPS, MAX_TORQUE, DT, GRAVITY, MASS, LENGTH, MAX_SPEED = range(7)
 
-#: Parameter row, in column order.
-PARAMS: tuple[float, ...] = (
-    200.0,  # time limit
-    2.0,  # torque bound
-    0.05,  # dt [s]
-    10.0,  # gravity
-    1.0,  # mass [kg]
-    1.0,  # length [m]
-    8.0,  # |theta_dot| bound
-)
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+PARAMS: tuple[float, ...] = registry.PENDULUM.params
 
-STATE_DIM = 2
+STATE_DIM = registry.PENDULUM.state_dim
 
 _PI = math.pi
 

@@ -19,18 +19,17 @@ Conventions (used by the stored figures and by the re-measuring functions):
 
 from __future__ import annotations
 
-import math
-from typing import NamedTuple
-
 import numpy as np
 
-from mtpg.envs.core import CARTCENTERING, TASK_NAMES
+from mtpg.envs.core import CARTCENTERING
 from mtpg.envs.protocol import (  # noqa: F401  (the seed bases live in protocol)
     N_TEST_EPISODES,
     RANDOM_SEED_BASE,
     TEST_SEED_BASE,
     held_out_seeds,
 )
+from mtpg.envs.registry import TASKS
+from mtpg.envs.taskspec import Reference
 
 #: Seed of the random agent's action generator.
 RANDOM_ACTION_SEED = 12345
@@ -51,24 +50,6 @@ def make_test_seeds(n: int = N_TEST_EPISODES) -> np.ndarray:
     return held_out_seeds(n)
 
 
-class Reference(NamedTuple):
-    """Reference figures of one task.
-
-    Attributes:
-        random: Mean score of the random agent (see the module docstring).
-        random_std: Standard deviation of that score.
-        best: Reference best score (Fig. 6 normalisation).
-        solved: Registered solved threshold, or NaN when there is none.
-        source: Where ``best`` comes from.
-    """
-
-    random: float
-    random_std: float
-    best: float
-    solved: float
-    source: str
-
-
 def measure_random(
     task: int,
     n: int = N_RANDOM_EPISODES,
@@ -78,7 +59,7 @@ def measure_random(
     """Measures the random agent's mean score (the ``random`` of the normalisation).
 
     Args:
-        task: The task id.
+        task: The task id (a variant's too: its reference scores are measured this way).
         n: Number of episodes.
         seed: Seed of the action generator.
         seed_base: Episode ``i`` uses episode seed ``seed_base + i``.
@@ -88,10 +69,11 @@ def measure_random(
     """
     from mtpg.envs.episodes import make_episodes
     from mtpg.envs.rollout import run_episodes
-    from mtpg.envs.tasks import ACTION_BOUND, MAX_STEPS, TASK_PARAMS
+    from mtpg.envs.variants import spec_of, task_params
 
-    limit = int(MAX_STEPS[task])
-    bound = float(ACTION_BOUND[task])
+    spec = spec_of(task)
+    limit = spec.max_steps
+    bound = spec.bound
     rng = np.random.default_rng(seed)
     returns = np.zeros(n)
     for lo in range(0, n, _CHUNK):
@@ -99,7 +81,7 @@ def measure_random(
         starts, noise = make_episodes(np.full(m, task), seed_base + lo + np.arange(m))
         a_d = rng.integers(0, 3, (m, limit))
         a_c = rng.uniform(-bound, bound, (m, limit))
-        returns[lo : lo + m] = run_episodes(task, TASK_PARAMS, starts, noise, a_d, a_c)
+        returns[lo : lo + m] = run_episodes(task, task_params(), starts, noise, a_d, a_c)
     return float(returns.mean()), float(returns.std())
 
 
@@ -124,39 +106,44 @@ def measure_time_optimal_cartcentering(
     return float(returns.mean()), float(steps.mean()), int(captured.sum())
 
 
-_NONE = math.nan
+#: One entry per task id, from the registry (each spec's ``reference``, with its source
+#: in ``mtpg.envs.registry``). ``random`` / ``random_std``: measured by this project with
+#: ``measure_random(task)`` (10,000 episodes, conventions in the module docstring).
+#: Re-measured by ``tests/envs/test_reference.py`` (slow).
+REFERENCE: tuple[Reference, ...] = tuple(t.reference for t in TASKS)
 
-# One entry per task id. ``random`` / ``random_std``: measured by this project with
-# ``measure_random(task)`` (10,000 episodes, conventions in the module docstring), numpy 2.4,
-# numba 0.68. Re-measured by ``tests/envs/test_reference.py`` (slow).
-REFERENCE: tuple[Reference, ...] = (
-    # CartPole: best = solved = 195, Gym/Gymnasium CartPole-v0 reward_threshold.
-    Reference(18.9678, 10.431719089392697, 195.0, 195.0, "CartPole-v0 reward_threshold"),
-    # Acrobot: best = solved = -100, Gym/Gymnasium Acrobot-v1 reward_threshold (the paper's
-    # D4PG figure could not be traced for Gym's Acrobot; spec/environments.md).
-    Reference(-500.0, 0.0, -100.0, -100.0, "Acrobot-v1 reward_threshold"),
-    # CartCentering: best = mean score of Koza's time-optimal law under this implementation
-    # on the test episodes (seeds 1_000_000..1_000_099), measure_time_optimal_cartcentering();
-    # all 100 captured, mean 126.73 steps. No registered threshold.
-    Reference(
-        -0.9873404751314238,
-        0.2377274856515104,
-        -0.028608253024208153,
-        _NONE,
-        "time-optimal law, measured on the test seeds",
-    ),
-    # Pendulum: best = -123.11 +- 6.86, D4PG (msinto93), the top Pendulum-v0 entry of the
-    # OpenAI Gym wiki leaderboard, 100 test episodes. No registered threshold.
-    Reference(-1234.575608635256, 289.45830639340454, -123.11, _NONE, "Gym leaderboard, D4PG"),
-    # MountainCar: best = solved = -110, Gym/Gymnasium MountainCar-v0 reward_threshold.
-    Reference(-200.0, 0.0, -110.0, -110.0, "MountainCar-v0 reward_threshold"),
-    # MountainCarContinuous: best = solved = 90, MountainCarContinuous-v0 reward_threshold.
-    Reference(
-        -33.10653758859584, 4.803512011466331, 90.0, 90.0, "MountainCarContinuous-v0 threshold"
-    ),
-)
 
-assert len(REFERENCE) == len(TASK_NAMES)
+_MEASURED: dict[str, Reference] = {}
+
+
+def reference_of(task: int | str) -> Reference:
+    """The reference scores of a task or variant.
+
+    A registered task's are its spec's. A variant's are measured on first use in the
+    process and kept: ``random`` / ``random_std`` by :func:`measure_random` on the variant
+    itself (its own dynamics and time limit), and ``best`` the base task's reference best,
+    with the source saying so (the variant's own best is not known; a changed time limit
+    may allow more).
+
+    Args:
+        task: A task id or name.
+    """
+    from mtpg.envs.variants import resolve, spec_of
+
+    spec = spec_of(resolve(task) if isinstance(task, str) else int(task))
+    if not spec.base:
+        return spec.reference
+    if spec.name not in _MEASURED:
+        mean, std = measure_random(resolve(spec.name))
+        base = spec_of(spec.base).reference
+        _MEASURED[spec.name] = Reference(
+            mean,
+            std,
+            base.best,
+            base.solved,
+            f"random measured; best of {spec.base}: {base.source}",
+        )
+    return _MEASURED[spec.name]
 
 
 def normalise(
@@ -176,11 +163,13 @@ def normalise(
     Raises:
         ValueError: If ``best`` equals the random score.
     """
-    ref = REFERENCE[int(task)]
+    from mtpg.envs.variants import spec_of
+
+    ref = reference_of(int(task))
     top = ref.best if best is None else float(best)
     span = top - ref.random
     if span == 0:
-        raise ValueError(f"best equals the random score of {TASK_NAMES[int(task)]}")
+        raise ValueError(f"best equals the random score of {spec_of(int(task)).name}")
     if isinstance(score, np.ndarray):
         return (score - ref.random) / span
     return (float(score) - ref.random) / span

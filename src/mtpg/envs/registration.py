@@ -1,4 +1,4 @@
-"""Registers the six tasks with Gymnasium under the ``mtpg/`` namespace.
+"""Registers every task of the registry with Gymnasium under the ``mtpg/`` namespace.
 
 Only Gymnasium is imported here; the environment class (and numba) loads when an
 environment is made.
@@ -6,16 +6,20 @@ environment is made.
 
 from __future__ import annotations
 
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
 
 #: Gymnasium ids, in task-id order.
-GYM_IDS: tuple[str, ...] = tuple(f"mtpg/{name}-v0" for name in TASK_NAMES)
+GYM_IDS: tuple[str, ...] = tuple(t.gym_id for t in TASKS)
 
 ENTRY_POINT = "mtpg.envs.gym_env:MtpgEnv"
 
+#: Gymnasium id of the multi-task environment (:mod:`mtpg.envs.multitask`).
+MULTITASK_ID = "mtpg/MultiTask-v0"
+MULTITASK_ENTRY_POINT = "mtpg.envs.multitask:MultiTaskEnv"
+
 
 def register_envs() -> None:
-    """Registers every task id with Gymnasium (idempotent).
+    """Registers every task id and ``mtpg/MultiTask-v0`` with Gymnasium (idempotent).
 
     The time limit is enforced by the environment itself (it reports ``truncated``), so
     no ``TimeLimit`` wrapper is added.
@@ -30,4 +34,8 @@ def register_envs() -> None:
             entry_point=ENTRY_POINT,
             kwargs={"task": task},
             disable_env_checker=False,
+        )
+    if MULTITASK_ID not in gymnasium.registry:
+        gymnasium.register(
+            id=MULTITASK_ID, entry_point=MULTITASK_ENTRY_POINT, disable_env_checker=False
         )

@@ -1,4 +1,8 @@
-"""Frames of the six tasks: Gymnasium's classic-control renderers, and one for CartCentering."""
+"""Frames of the tasks: Gymnasium's classic-control renderers, and one for CartCentering.
+
+Which renderer draws a task is its spec's ``render`` field (:mod:`mtpg.envs.registry`): a
+Gymnasium ``classic_control`` class name, or ``""`` for the class ``<name>Renderer`` here.
+"""
 
 from __future__ import annotations
 
@@ -8,15 +12,10 @@ import numpy as np
 
 from mtpg.envs import cartcentering
 from mtpg.envs._util import clip
-from mtpg.envs.core import (
-    ACROBOT,
-    CARTCENTERING,
-    CARTPOLE,
-    MOUNTAINCAR,
-    MOUNTAINCARCONTINUOUS,
-    PENDULUM,
-)
-from mtpg.envs.tasks import STATE_DIMS, TASK_PARAMS
+from mtpg.envs.core import CARTCENTERING, PENDULUM
+from mtpg.envs.registry import spec
+from mtpg.envs.tasks import TASK_PARAMS
+from mtpg.envs.variants import spec_of
 
 
 class GymRenderer:
@@ -27,23 +26,12 @@ class GymRenderer:
     """
 
     def __init__(self, task: int):
-        from gymnasium.envs.classic_control import (
-            AcrobotEnv,
-            CartPoleEnv,
-            Continuous_MountainCarEnv,
-            MountainCarEnv,
-            PendulumEnv,
-        )
+        from gymnasium.envs import classic_control
 
-        classes = {
-            CARTPOLE: CartPoleEnv,
-            ACROBOT: AcrobotEnv,
-            PENDULUM: PendulumEnv,
-            MOUNTAINCAR: MountainCarEnv,
-            MOUNTAINCARCONTINUOUS: Continuous_MountainCarEnv,
-        }
         self.task = task
-        self.env: Any = classes[task](render_mode="rgb_array")
+        self.env: Any = getattr(classic_control, spec_of(task).render)(render_mode="rgb_array")
+        self.kind = spec_of(task).base or spec_of(task).name  # a variant draws as its base
+        self.dim = spec_of(task).state_dim
 
     def frame(self, state: np.ndarray, last_action: float) -> np.ndarray:
         """Renders one frame.
@@ -55,9 +43,10 @@ class GymRenderer:
         Returns:
             An ``H x W x 3`` uint8 frame.
         """
-        self.env.state = np.array(state[: STATE_DIMS[self.task]], dtype=np.float64)
-        if self.task == PENDULUM:
-            self.env.last_u = clip(last_action, -2.0, 2.0) if np.isfinite(last_action) else 0.0
+        self.env.state = np.array(state[: self.dim], dtype=np.float64)
+        if self.kind == spec(PENDULUM).name:
+            bound = spec(PENDULUM).bound
+            self.env.last_u = clip(last_action, -bound, bound) if np.isfinite(last_action) else 0.0
         return np.asarray(self.env.render(), dtype=np.uint8)
 
     def close(self) -> None:
@@ -132,6 +121,6 @@ def make_renderer(task: int) -> GymRenderer | CartCenteringRenderer:
     Returns:
         An object with ``frame(state, last_action)`` and ``close()``.
     """
-    if task == CARTCENTERING:
-        return CartCenteringRenderer()
-    return GymRenderer(task)
+    if spec_of(task).render:
+        return GymRenderer(task)
+    return globals()[f"{spec_of(task).base or spec_of(task).name}Renderer"]()

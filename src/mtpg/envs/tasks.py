@@ -1,4 +1,4 @@
-"""Every task constant as data: the parameter table and the per-task action facts.
+"""Every task constant as arrays, derived from the registry (:mod:`mtpg.envs.registry`).
 
 ``TASK_PARAMS[task]`` is one row per task id (see ``mtpg.envs.core``). Two columns are
 common to all tasks:
@@ -20,88 +20,94 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.registry import TASKS
 
 #: Common column: the time limit in steps.
 P_MAX_STEPS = 0
 #: Common column: the discrete force magnitude or the continuous action bound.
 P_FORCE = 1
 
-_ROWS: tuple[tuple[float, ...], ...] = (
-    cartpole.PARAMS,
-    acrobot.PARAMS,
-    cartcentering.PARAMS,
-    pendulum.PARAMS,
-    mountaincar.PARAMS_DISCRETE,
-    mountaincar.PARAMS_CONTINUOUS,
-)
+#: Number of task columns (the longest parameter row of the registry).
+N_TASK_COLUMNS = max(len(t.params) for t in TASKS)
+
+# Interface columns, after every task's own: how the row is dispatched and observed.
+#: The base task's id: the dispatch of ``mtpg.envs.kernels`` branches on it.
+P_KIND = N_TASK_COLUMNS
+#: 0: the task's own observation kernel; 1: a variant's observation (columns below).
+P_OBS = N_TASK_COLUMNS + 1
+#: Two columns: the state slot each input observes (-1: the U[0, 1] noise input).
+P_OBS_SLOT = N_TASK_COLUMNS + 2
+#: Two columns: the value each observed slot maps to -1.
+P_OBS_LO = N_TASK_COLUMNS + 4
+#: Two columns: the value each observed slot maps to +1.
+P_OBS_HI = N_TASK_COLUMNS + 6
+#: Two columns: 1 when the observed slot is an angle wrapped into [-pi, pi) first.
+P_OBS_WRAP = N_TASK_COLUMNS + 8
 
 #: Number of columns of ``TASK_PARAMS``.
-N_PARAMS = max(len(r) for r in _ROWS)
+N_PARAMS = N_TASK_COLUMNS + 10
 #: Number of tasks.
-N_TASKS = len(TASK_NAMES)
+N_TASKS = len(TASKS)
 
 
-def _table() -> np.ndarray:
-    table = np.zeros((N_TASKS, N_PARAMS), dtype=np.float64)
-    for i, row in enumerate(_ROWS):
-        table[i, : len(row)] = row
+def param_row(
+    params: tuple[float, ...],
+    kind: int,
+    observe: tuple[tuple[int, float, float, bool], ...] | None = None,
+) -> np.ndarray:
+    """One row of the parameter table: the task's columns, then the interface columns.
+
+    Args:
+        params: The task's parameter row.
+        kind: The id of the task whose kernels play the row.
+        observe: None for the task's own observation, else up to two
+            ``(slot, low, high, wrap)`` inputs (a missing second input is noise).
+
+    Returns:
+        float64 ``[N_PARAMS]``; unused task columns are 0.
+    """
+    row = np.zeros(N_PARAMS, dtype=np.float64)
+    row[: len(params)] = params
+    row[P_KIND] = kind
+    if observe is not None:
+        row[P_OBS] = 1.0
+        row[P_OBS_SLOT : P_OBS_SLOT + 2] = -1.0
+        for i, (slot, lo, hi, wrap) in enumerate(observe):
+            row[P_OBS_SLOT + i] = slot
+            row[P_OBS_LO + i] = lo
+            row[P_OBS_HI + i] = hi
+            row[P_OBS_WRAP + i] = float(wrap)
+    return row
+
+
+def params_table(rows: list[np.ndarray]) -> np.ndarray:
+    """Stacks rows of :func:`param_row` into a read-only float64 table."""
+    table = np.array(rows, dtype=np.float64).reshape(len(rows), N_PARAMS)
     table.setflags(write=False)
     return table
 
 
-#: float64 [N_TASKS, N_PARAMS]: every task constant (read-only).
-TASK_PARAMS: np.ndarray = _table()
+#: float64 [N_TASKS, N_PARAMS]: every task constant (read-only); variants add rows to
+#: ``mtpg.envs.variants.task_params()``.
+TASK_PARAMS: np.ndarray = params_table([param_row(t.params, i) for i, t in enumerate(TASKS)])
 
 #: int64 [N_TASKS]: time limits in steps (200, 500, 500, 200, 200, 999).
-MAX_STEPS: np.ndarray = TASK_PARAMS[:, P_MAX_STEPS].astype(np.int64)
+MAX_STEPS: np.ndarray = np.array([t.max_steps for t in TASKS], dtype=np.int64)
 
 #: bool [N_TASKS]: whether the task reads the continuous action ``a_c`` (else ``a_d``).
-USES_CONTINUOUS: np.ndarray = np.array([False, True, False, True, False, True])
+USES_CONTINUOUS: np.ndarray = np.array([t.continuous for t in TASKS])
 
 #: float64 [N_TASKS]: bound of the continuous action (0 for discrete tasks).
-ACTION_BOUND: np.ndarray = np.where(USES_CONTINUOUS, TASK_PARAMS[:, P_FORCE], 0.0)
+ACTION_BOUND: np.ndarray = np.array([t.bound for t in TASKS], dtype=np.float64)
 
 #: int64 [N_TASKS]: number of physical state variables (slots 0.. of the state array).
-STATE_DIMS: np.ndarray = np.array(
-    [
-        cartpole.STATE_DIM,
-        acrobot.STATE_DIM,
-        cartcentering.STATE_DIM,
-        pendulum.STATE_DIM,
-        mountaincar.STATE_DIM,
-        mountaincar.STATE_DIM,
-    ],
-    dtype=np.int64,
-)
+STATE_DIMS: np.ndarray = np.array([t.state_dim for t in TASKS], dtype=np.int64)
 
 #: Names of the physical state variables, in Gymnasium's order.
-STATE_NAMES: tuple[tuple[str, ...], ...] = (
-    ("x", "x_dot", "theta", "theta_dot"),
-    ("theta1", "theta2", "dtheta1", "dtheta2"),
-    ("x", "v"),
-    ("theta", "theta_dot"),
-    ("position", "velocity"),
-    ("position", "velocity"),
-)
+STATE_NAMES: tuple[tuple[str, ...], ...] = tuple(t.state_names for t in TASKS)
 
 #: What the two inputs observe, per task.
-OBSERVED: tuple[str, ...] = (
-    "x/2.4, theta/0.2094",
-    "theta1/pi, theta2/pi",
-    "x/1.5, noise",
-    "wrap(theta)/pi, noise",
-    "2(x+1.2)/1.8-1, noise",
-    "2(x+1.2)/1.8-1, noise",
-)
+OBSERVED: tuple[str, ...] = tuple(t.observed for t in TASKS)
 
 #: The action each task reads, and its meaning.
-ACTION_USED: tuple[str, ...] = (
-    "a_d: +10N/prev/-10N",
-    "a_c: torque in [-1,1]",
-    "a_d: +1N/prev/-1N",
-    "a_c: torque in [-2,2]",
-    "a_d: +1/0/-1 push",
-    "a_c: force in [-1,1]",
-)
+ACTION_USED: tuple[str, ...] = tuple(t.action_text for t in TASKS)

@@ -15,8 +15,8 @@ from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.evaluator import make_evaluator
-from mtpg.envs.core import TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds, resampled_training_seeds, validation_seeds
+from mtpg.envs.variants import spec_of
 from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
 from mtpg.evolve.validation import choose
@@ -168,7 +168,7 @@ class Trainer:
 
     def subset_names(self, k: int) -> tuple[str, ...]:
         """Task names of subset ``k``."""
-        return tuple(TASK_NAMES[self.task_ids[i]] for i in self.subsets[k])
+        return tuple(spec_of(self.task_ids[i]).name for i in self.subsets[k])
 
     def run_generation(self) -> dict[str, float]:
         """Runs one generation and returns its metrics row.
@@ -246,7 +246,7 @@ class Trainer:
                 "teams_per_decision": float(per_root[i] / steps[i]),
             }
             for j, task in enumerate(self.task_ids):
-                row[f"test_{TASK_NAMES[task]}"] = float(means[i, j])
+                row[f"test_{spec_of(task).name}"] = float(means[i, j])
             rows.append(row)
         return rows
 
@@ -357,8 +357,8 @@ class Trainer:
             "champion_teams": len(pop.reachable(st.champions[-1])),
         }
         for k, task in enumerate(self.task_ids):
-            row[f"best_{TASK_NAMES[task]}"] = float(scores[:, k].max())
-            row[f"median_{TASK_NAMES[task]}"] = float(np.median(scores[:, k]))
+            row[f"best_{spec_of(task).name}"] = float(scores[:, k].max())
+            row[f"median_{spec_of(task).name}"] = float(np.median(scores[:, k]))
         row.update(self._extra)
         t0, t1, t2, t3 = times
         row.update(

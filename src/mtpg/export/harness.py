@@ -26,7 +26,7 @@ import numpy as np
 
 from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_episode
-from mtpg.envs import TASK_PARAMS, env_observe
+from mtpg.envs import env_observe
 from mtpg.model.graph import Population
 
 #: Flags of every compilation: C99, warnings as errors, no floating-point contraction.
@@ -177,7 +177,7 @@ def engine_stream(
         tr = trace_episode(cp, root, task, table.starts[e], table.noise[e], no_memory=no_memory)
         n = len(tr.actions)
         for t in range(n):
-            env_observe(task, TASK_PARAMS, tr.states[t], table.noise[e, t], o)
+            env_observe(task, table.params, tr.states[t], table.noise[e, t], o)
             obs_rows.append(o.copy())
         starts.extend([True] + [False] * (n - 1))
         actions.append(tr.actions)

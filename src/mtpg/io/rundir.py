@@ -368,13 +368,23 @@ def canonical_tasks(task_names: Iterable[str]) -> tuple[str, ...]:
     Raises:
         ValueError: For an empty set, an unknown name or a repeat.
     """
+    from mtpg.envs.variants import canonical, order_key
+
     names = tuple(task_names)
-    unknown = [t for t in names if t not in TASK_NAMES]
+    unknown = []
+    for t in names:
+        try:
+            known = canonical(t) == t
+        except ValueError:
+            known = False
+        if not known:
+            unknown.append(t)
     if not names or unknown or len(set(names)) != len(names):
         raise ValueError(
             f"task set {names} must be non-empty, without repeats, from {', '.join(TASK_NAMES)}"
+            " or their variants"
         )
-    return tuple(sorted(names, key=TASK_NAMES.index))
+    return tuple(sorted(names, key=order_key))
 
 
 def champion_filename(task_names: tuple[str, ...]) -> str:

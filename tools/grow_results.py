@@ -13,9 +13,10 @@ SIGINT, SIGHUP), the runs are sent SIGTERM, so each commits the generation under
 ends; then every run touched is tidied for the repository and committed with git:
 
 * only its newest checkpoint is kept (``mtpg train --resume`` needs nothing else);
-* of the test-point graph folders ``tests/gen-NNNNNN/`` only every
-  :data:`KEEP_TESTS_EVERY`-th generation and the newest are kept (the report and the
-  analyses read the newest; ``tests.csv`` keeps every test point's scores);
+* ``champions/`` is packed into ``champions.tar.xz``, and of the test-point graph folders
+  ``tests/gen-NNNNNN/`` every :data:`KEEP_TESTS_EVERY`-th generation is packed into
+  ``tests/archive.tar.xz`` and the newest is kept as it is (the report and the analyses
+  read it; ``tests.csv`` keeps every test point's scores);
 * a row is appended to its ``provenance.csv``: generations from/to, the mtpg commit that
   ran them, start time, wall-clock and CPU seconds, workers, processor and host.
 
@@ -35,6 +36,8 @@ import shutil
 import signal
 import subprocess
 import sys
+import tarfile
+import tempfile
 import time
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -52,6 +55,9 @@ KEEP_TESTS_EVERY = 100
 #: Seconds a run is given to commit after SIGTERM before it is told to stop at once.
 STOP_GRACE_S = 300
 PROVENANCE = "provenance.csv"
+#: The packed champion files and test-point folders of a run (see :func:`tidy`).
+PACKED_CHAMPIONS = "champions.tar.xz"
+PACKED_TESTS = "archive.tar.xz"
 PROVENANCE_COLUMNS = (
     "from_generation",
     "to_generation",
@@ -147,17 +153,50 @@ def start(name: str, seed: int, ablation: str | None, args: argparse.Namespace) 
     return Job(name, path, proc, last_generation(path))
 
 
+def _pack(folder: Path, names: list[str], archive: Path) -> None:
+    """Writes ``names`` (paths relative to ``folder``) into ``archive`` (tar, xz) atomically."""
+    tmp = archive.with_name(archive.name + ".tmp")
+    with tarfile.open(tmp, "w:xz") as tar:
+        for name in sorted(names):
+            tar.add(folder / name, arcname=name)
+    os.replace(tmp, archive)
+
+
 def tidy(run: Path) -> None:
-    """Keeps the newest checkpoint and every ``KEEP_TESTS_EVERY``-th test folder."""
+    """Keeps the newest checkpoint and test folder; packs the champions and older tests.
+
+    The 63 readable champion files of a run share most of their teams, so ``xz`` packs
+    them about 80 times smaller: ``champions/`` becomes ``champions.tar.xz`` (a resume
+    writes ``champions/`` anew from the checkpoint). Test folders of every
+    ``KEEP_TESTS_EVERY``-th generation go into ``tests/archive.tar.xz``; the newest stays
+    a folder, as the report and the analyses read it.
+    """
     ckpts = sorted((run / "checkpoints").glob("gen-*"))
     for extra in ckpts[:-1]:
         extra.unlink()
     newest = last_generation(run)
-    folders = sorted((run / "tests").glob("gen-??????"))
-    kept = [f for f in folders if int(f.name[4:]) <= newest]
-    for f in kept[:-1]:
-        if int(f.name[4:]) % KEEP_TESTS_EVERY:
-            shutil.rmtree(f)
+    champions = run / "champions"
+    if champions.is_dir() and any(champions.iterdir()):
+        _pack(run, [f"champions/{p.name}" for p in champions.iterdir()], run / PACKED_CHAMPIONS)
+        shutil.rmtree(champions)
+    tests = run / "tests"
+    folders = [f for f in sorted(tests.glob("gen-??????")) if int(f.name[4:]) <= newest]
+    archive = tests / PACKED_TESTS
+    old = folders[:-1]
+    if not old:
+        return
+    with tempfile.TemporaryDirectory(dir=tests) as tmp:
+        if archive.exists():
+            with tarfile.open(archive) as tar:
+                tar.extractall(tmp, filter="data")
+        for f in old:
+            if int(f.name[4:]) % KEEP_TESTS_EVERY == 0:
+                shutil.rmtree(Path(tmp) / f.name, ignore_errors=True)
+                shutil.copytree(f, Path(tmp) / f.name)
+        kept = [p.name for p in Path(tmp).iterdir() if int(p.name[4:]) % KEEP_TESTS_EVERY == 0]
+        _pack(Path(tmp), kept, archive)
+    for f in old:
+        shutil.rmtree(f)
 
 
 def record(job: Job, commit: str, workers: int) -> None:

@@ -40,11 +40,13 @@ TARGET = 1000
 GROWING = [
     "## Growing the runs",
     "",
-    "Each run directory holds `config.toml`, `metrics.csv`, `tests.csv`, `champions/`, its "
-    f"newest checkpoint, the test-point graphs of every {KEEP_TESTS_EVERY}th generation and "
-    "of the latest "
-    "test point (`tests/gen-NNNNNN/`; `tests.csv` has the scores of every test point), and "
-    "`provenance.csv`: which mtpg commit ran which generations, when, for how long, on "
+    "Each run directory holds `config.toml`, `metrics.csv`, `tests.csv`, its newest "
+    "checkpoint, the champion files of all 63 task subsets packed in `champions.tar.xz` "
+    "(`tar xf champions.tar.xz`; a resume writes `champions/` anew), the test-point "
+    "graphs of the latest test point in `tests/gen-NNNNNN/` and those of every "
+    f"{KEEP_TESTS_EVERY}th generation packed in `tests/archive.tar.xz` (`tests.csv` has "
+    "the scores of every test point), and `provenance.csv`: which mtpg commit ran which "
+    "generations, when, for how long, on "
     "which processor. To continue them, from a clone of the repository:",
     "",
     "```sh",

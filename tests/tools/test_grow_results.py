@@ -4,6 +4,7 @@ import csv
 import importlib.util
 import subprocess
 import sys
+import tarfile
 from pathlib import Path
 
 from stopruns import mtpg, without_timing
@@ -68,11 +69,26 @@ def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypa
         assert (grown / "checkpoints" / final).read_bytes() == (
             ref / "checkpoints" / final
         ).read_bytes()
+        assert not (grown / "champions").exists()
+        with tarfile.open(grown / "champions.tar.xz") as tar:
+            tar.extractall(tmp_path / f"{name}-unpacked", filter="data")
+        for graph in (ref / "champions").iterdir():
+            packed = tmp_path / f"{name}-unpacked" / "champions" / graph.name
+            assert packed.read_bytes() == graph.read_bytes()
         kept = sorted(p.name for p in (grown / "tests").iterdir())
-        assert kept == ["gen-000008", "gen-000016", "gen-000024"]
-        for folder in kept:
+        assert kept == ["archive.tar.xz", "gen-000024"]
+        with tarfile.open(grown / "tests" / "archive.tar.xz") as tar:
+            tar.extractall(tmp_path / f"{name}-tests", filter="data")
+        assert sorted(p.name for p in (tmp_path / f"{name}-tests").iterdir()) == [
+            "gen-000008",
+            "gen-000016",
+        ]
+        for folder in ("gen-000008", "gen-000016"):
             for graph in (ref / "tests" / folder).iterdir():
-                assert (grown / "tests" / folder / graph.name).read_bytes() == graph.read_bytes()
+                packed = tmp_path / f"{name}-tests" / folder / graph.name
+                assert packed.read_bytes() == graph.read_bytes()
+        for graph in (ref / "tests" / "gen-000024").iterdir():
+            assert (grown / "tests" / "gen-000024" / graph.name).read_bytes() == graph.read_bytes()
         rows = list(csv.DictReader(open(grown / "provenance.csv")))
         assert len(rows) >= 2 and rows[0]["from_generation"] == "0"
         assert rows[-1]["to_generation"] == str(GENERATIONS)

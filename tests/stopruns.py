@@ -12,19 +12,17 @@ from pathlib import Path
 from mtpg.evolve.trainer import TIMING_COLUMNS
 from tinyruns import tiny_args
 
-#: A tiny run with test points (2, 4, 6) and commits (3, 6 and the end, 7).
-ARGS = [
-    *tiny_args(
-        "CartPole,MountainCar",
-        root_size=20,
-        n_elite=3,
-        evaluation__test_interval=2,
-        evaluation__test_episodes=3,
-        checkpoint_interval=3,
-    ),
-    "--generations",
-    "7",
-]
+#: Settings of a tiny run with a test point every 2 generations and a commit every 3.
+SETTINGS = tiny_args(
+    "CartPole,MountainCar",
+    root_size=20,
+    n_elite=3,
+    evaluation__test_interval=2,
+    evaluation__test_episodes=3,
+    checkpoint_interval=3,
+)
+#: That run for 7 generations: test points 2, 4, 6 and commits 3, 6 and the end, 7.
+ARGS = [*SETTINGS, "--generations", "7"]
 
 
 def mtpg(*args, env=None, **kw):

@@ -7,18 +7,9 @@ import sys
 import tarfile
 from pathlib import Path
 
-from stopruns import mtpg, without_timing
-from tinyruns import tiny_args
+from stopruns import SETTINGS, mtpg, without_timing
 
 TOOL = Path(__file__).parents[2] / "tools" / "grow_results.py"
-SETTINGS = tiny_args(
-    "CartPole,MountainCar",
-    root_size=20,
-    n_elite=3,
-    evaluation__test_interval=2,
-    evaluation__test_episodes=3,
-    checkpoint_interval=3,
-)
 GENERATIONS = 24
 
 

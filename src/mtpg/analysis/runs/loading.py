@@ -2,7 +2,7 @@
 
 ``normalised = (score - random) / (best - random)``: 0 is random play; ``best`` is either
 a single-task champion (Figs. 5 and 7) or the reference best of the task (Fig. 6); see
-:mod:`mtpg.analysis.numbers` for which champion every reported number comes from.
+:mod:`mtpg.analysis.runs.reported_numbers` for which champion every reported number comes from.
 
 Runs are grouped by configuration: two runs belong to one group when their configurations
 are equal in everything but the seed and the settings that do not change what a run

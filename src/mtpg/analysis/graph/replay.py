@@ -5,7 +5,7 @@ A replay plays the same held-out episodes as ``mtpg evaluate`` (seeds from
 decisions of the batch kernel, so the returns are equal.
 
 ``.npz`` schema (version 1). ``N`` steps over all episodes, ``E`` episodes, teams, banks
-and programs numbered as in :mod:`mtpg.analysis.graphinfo` (team 1 is the root). Ragged
+and programs numbered as in :mod:`mtpg.analysis.description.numbering` (team 1 is the root). Ragged
 per-step lists are flat arrays with offsets: the entries of step ``i`` are
 ``x[x_offsets[i]:x_offsets[i + 1]]``.
 
@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.graphinfo import effective_instruction_map, index_graph
+from mtpg.analysis.description.numbering import effective_instruction_map, index_graph
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs import make_episodes

@@ -2,8 +2,9 @@
 
 The layout is layered by depth (shortest distance from the root, which is on top), using
 networkx's ``multipartite_layout``; networkx is a well-kept graph library, so the project
-does not maintain its own graph algorithms. DOT (:func:`mtpg.analysis.graphinfo.graph_dot`)
-is written beside a picture, and rendered to SVG only when GraphViz's ``dot`` is on PATH.
+does not maintain its own graph algorithms. DOT
+(:func:`mtpg.analysis.description.listing.graph_dot`) is written beside a picture, and
+rendered to SVG only when GraphViz's ``dot`` is on PATH.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.graphinfo import index_graph
+from mtpg.analysis.description.numbering import index_graph
 from mtpg.analysis.palette import IDLE_COLOUR, PATH_COLOUR
 from mtpg.model.graph import Population
 

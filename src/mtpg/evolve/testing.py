@@ -109,19 +109,10 @@ def play_test(
     no_memory: bool = False,
     evaluate: Evaluate | None = None,
 ) -> PlayedEpisodes:
-    """The test: every root on ``episodes`` held-out episodes of every task.
+    """The test: :func:`play_episodes` on ``episodes`` held-out episodes of every task.
 
-    Args:
-        pop: The population (or its compiled form) holding the roots.
-        roots: Root team ids.
-        task_ids: Task ids.
-        episodes: Held-out episodes per task.
-        seed: Offset of the test seeds (0 for a run's own test points).
-        no_memory: Play with the no-memory ablation semantics.
-        evaluate: How to play (default: one thread of this machine).
-
-    Returns:
-        The measurements, ``[roots, tasks, episodes]``.
+    The seeds are :func:`mtpg.envs.protocol.held_out_seeds` ``(episodes, seed)``: ``seed``
+    is their offset, 0 for a run's own test points.
     """
     seeds = held_out_seeds(episodes, seed)
     return play_episodes(pop, roots, task_ids, seeds, no_memory, evaluate)

@@ -112,8 +112,8 @@ def test_ablations_each_change_one_setting() -> None:
         section, field = key.split(".")
         cfg = build_config("paper", overrides=[f"{key}={str(value).lower()}"])
         assert to_dict(cfg)[section][field] == value, name
-    assert build_config("paper", overrides=["team.p_atomic=1.0"]).no_hierarchy
-    assert not build_config("paper").no_hierarchy
+    assert build_config("paper", overrides=["team.p_atomic=1.0"]).ablations == ("no-hierarchy",)
+    assert build_config("paper").ablations == ()
 
 
 ALL = "CartPole, Acrobot, CartCentering, Pendulum, MountainCar, MountainCarContinuous"

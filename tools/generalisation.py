@@ -14,7 +14,7 @@ Scenarios (``demo`` preset): ``cartpole`` and ``pendulum`` (one task, 5 seeds) a
 options beyond it (:data:`SETTINGS`). Scores are reference-normalised test scores of each
 run's final champion (one task: the task's champion; six tasks: the all-task champion on
 every task, and each single-task champion on its own task); the report gives their IQM with
-a 95% stratified bootstrap interval over seeds (:mod:`mtpg.analysis.stats`, tasks as
+a 95% stratified bootstrap interval over seeds (:mod:`mtpg.analysis.runs.statistics`, tasks as
 strata) and the cost of each setting: decisions played (training and validation, summed
 over the run) and the run's total wall time (``t_total`` summed, seconds).
 """
@@ -156,7 +156,7 @@ def _cost(run_dir: Path) -> tuple[float, float]:
 
 def _scores(run_dir: Path, generations: int) -> dict[str, list[float]]:
     """Reference-normalised final test scores: ``all`` (full-set champion) and ``single``."""
-    from mtpg.analysis.runs import load_run
+    from mtpg.analysis.runs.loading import load_run
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.reference import normalise
 
@@ -178,7 +178,7 @@ def report(args: argparse.Namespace) -> int:
     """Writes ``generalisation.json``, ``generalisation.md`` and ``generalisation.png``."""
     import numpy as np
 
-    from mtpg.analysis.stats import aggregate_iqm
+    from mtpg.analysis.runs.statistics import aggregate_iqm
 
     rows = []
     for name, setting, _, gens, runs in _plan(args):

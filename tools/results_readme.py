@@ -9,8 +9,8 @@ with ``mtpg report`` into ``results/figures/``, the section-6 figures of the bes
 all-task champion with ``mtpg analyze`` into ``results/analysis/``, and writes the README:
 status and cost of every run, the tables behind the figures, and the comparison with the
 paper task by task. Every number in the text is computed here from the runs' files, by the
-same library functions the report uses (:mod:`mtpg.analysis.numbers`,
-:mod:`mtpg.analysis.stats`).
+same library functions the report uses (:mod:`mtpg.analysis.runs.reported_numbers`,
+:mod:`mtpg.analysis.runs.statistics`).
 """
 
 from __future__ import annotations
@@ -86,10 +86,11 @@ def _fig(name: str, caption: str) -> str:
 
 def build(results: Path, analyze: bool = True) -> Path:
     """Writes the figures and ``README.md`` of ``results``; returns the README's path."""
-    from mtpg.analysis.numbers import BEST_RUN_RULE, CHAMPION_RULE, best_of, run_numbers
-    from mtpg.analysis.plots_stats import STATS_NOTE, group_estimates
-    from mtpg.analysis.report import build_report
-    from mtpg.analysis.runs import group_runs, load_run
+    from mtpg.analysis.runs.champions import CHAMPION_RULE
+    from mtpg.analysis.runs.loading import group_runs, load_run
+    from mtpg.analysis.runs.report import build_report
+    from mtpg.analysis.runs.reported_numbers import BEST_RUN_RULE, best_of, run_numbers
+    from mtpg.analysis.runs.statistics_figures import STATS_NOTE, group_estimates
 
     paths = _runs(results)
     runs = [load_run(p) for p in paths]
@@ -244,7 +245,7 @@ def build(results: Path, analyze: bool = True) -> Path:
 
 
 def _vs(test: dict[str, float], best: dict[str, float], tasks) -> list[float]:
-    from mtpg.analysis.runs import normalise_scores
+    from mtpg.analysis.runs.loading import normalise_scores
 
     v = normalise_scores(test, best)
     return [v[t] for t in tasks]

@@ -123,7 +123,7 @@ def verdict(ours: float, paper: float) -> str:
 
 def first_reached(run, task: str, best_single: float, level: float) -> str:
     """First test point at which the run's all-task champion reached ``level`` in ``task``."""
-    from mtpg.analysis.runs import normalise_scores
+    from mtpg.analysis.runs.loading import normalise_scores
 
     gens, scores = run.curve(run.full_set, task)
     for g, s in zip(gens, scores, strict=True):
@@ -134,7 +134,7 @@ def first_reached(run, task: str, best_single: float, level: float) -> str:
 
 def compare_table(best, best_single: dict[str, float], tasks) -> list[str]:
     """Per task: the best run's all-task champion against the paper's Figs. 5 and 6."""
-    from mtpg.analysis.runs import normalise_scores
+    from mtpg.analysis.runs.loading import normalise_scores
 
     vs = normalise_scores(best.test, best_single)
     paper = PAPER["best_vs_single"]
@@ -169,8 +169,8 @@ def compare_table(best, best_single: dict[str, float], tasks) -> list[str]:
 
 def ablation_rows(groups, numbers, best_single, tasks) -> tuple[list[str], list[list[str]]]:
     """Each ablation's best run against the best single-task champion, beside the paper."""
-    from mtpg.analysis.numbers import best_of
-    from mtpg.analysis.runs import normalise_scores
+    from mtpg.analysis.runs.loading import normalise_scores
+    from mtpg.analysis.runs.reported_numbers import best_of
 
     head = ["experiment", "run", "generation", "min vs single", "max vs single", "paper"]
     rows = []
@@ -203,8 +203,8 @@ def rescore_rows(runs) -> tuple[list[str], list[list[str]]]:
     scores of ``tests.csv``); the re-score plays ``n`` other held-out episodes
     (:data:`RESCORE_OFFSET`), which should fall inside it about 95% of the time.
     """
-    from mtpg.analysis.evaluate import evaluate_graph
-    from mtpg.analysis.numbers import champion_path
+    from mtpg.analysis.runs.champions import champion_path
+    from mtpg.evolve.testing import evaluate_graph
     from mtpg.io.serialize import load_graph
 
     tasks = runs[0].tasks

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from mtpg.ablations import ABLATIONS as ABLATIONS  # re-exported: the table lives there
 from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
 from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
 from mtpg.limits import LIMITS
-from mtpg.presets import ABLATIONS as ABLATIONS  # re-exported: presets live there
 from mtpg.presets import EXTENSIONS as EXTENSIONS
 from mtpg.presets import PARENT_SELECTIONS, PRESETS
 
@@ -258,9 +258,11 @@ class RunConfig:
         return max(self.team.n_elite, -(-self.team.min_elite_total // n))
 
     @property
-    def no_hierarchy(self) -> bool:
-        """True for the no-hierarchy ablation (``p_atomic = 1``)."""
-        return self.team.p_atomic == 1.0
+    def ablations(self) -> tuple[str, ...]:
+        """The switches of the ablations this configuration has on (:mod:`mtpg.ablations`)."""
+        from mtpg.ablations import ablations_on
+
+        return tuple(a.switch for a in ablations_on(self))
 
 
 _SECTIONS = {"program": ProgramConfig, "team": TeamConfig, "evaluation": EvaluationConfig}

@@ -1,4 +1,4 @@
-"""Named presets, ablation switches and the settings beyond the paper (data only).
+"""Named presets and the settings beyond the paper (data only; ablations: :mod:`mtpg.ablations`).
 
 Re-exported by :mod:`mtpg.config`, which validates them like any other settings.
 """
@@ -28,11 +28,4 @@ PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
 EXTENSIONS: dict[str, tuple[str, ...]] = {
     "team": ("parent_selection",),
     "evaluation": ("validation_episodes", "validation_top_k", "resample_interval"),
-}
-
-#: Ablation switches (section 5.2): each changes exactly one setting.
-ABLATIONS: dict[str, tuple[str, Any]] = {
-    "no-crossover": ("team.p_crossover", 0.0),
-    "no-memory": ("evaluation.no_memory", True),
-    "no-hierarchy": ("team.p_atomic", 1.0),
 }

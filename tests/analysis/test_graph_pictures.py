@@ -1,9 +1,10 @@
 import numpy as np
 
 from inside_graphs import cycle, writer_every_k
-from mtpg.analysis.graphinfo import graph_dot, index_graph
-from mtpg.analysis.graphlayout import GraphDrawing, layout_graph, render_svg
-from mtpg.analysis.hierarchy import hierarchy_statistics, mean_by_size
+from mtpg.analysis.description.layout import GraphDrawing, layout_graph, render_svg
+from mtpg.analysis.description.listing import graph_dot
+from mtpg.analysis.description.numbering import index_graph
+from mtpg.analysis.runs.hierarchical_complexity import hierarchy_statistics, mean_by_size
 
 
 def test_layout_is_layered_by_depth_with_the_root_on_top():
@@ -15,7 +16,7 @@ def test_layout_is_layered_by_depth_with_the_root_on_top():
 
 
 def test_cycles_are_drawn_and_highlighted(tmp_path, monkeypatch):
-    from mtpg.analysis.figures6 import pyplot
+    from mtpg.analysis.plotting import pyplot
 
     pop, root = cycle()
     index = index_graph(pop, root)

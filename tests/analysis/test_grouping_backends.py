@@ -3,7 +3,7 @@
 from dataclasses import replace
 from pathlib import Path
 
-from mtpg.analysis.runs import RunData, group_runs
+from mtpg.analysis.runs.loading import RunData, group_runs
 from mtpg.config import build_config
 
 

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from inside_graphs import cycle, single_team, writer_every_k
-from mtpg.analysis.decompose import decomposition
-from mtpg.analysis.inside import (
+from mtpg.analysis.graph.decomposition import decomposition
+from mtpg.analysis.graph.measures import (
     best_register,
     register_access,
     scale_pm1,
@@ -11,7 +11,7 @@ from mtpg.analysis.inside import (
     velocity_prediction,
     visit_statistics,
 )
-from mtpg.analysis.replay import Replay, load_replay, replay_observations, replay_task
+from mtpg.analysis.graph.replay import Replay, load_replay, replay_observations, replay_task
 
 
 def hand_trace(task, visits_per_step, banks=None):
@@ -125,8 +125,8 @@ def test_a_cycle_forming_pointer_never_visits_a_team_twice():
 
 
 def test_replayed_returns_equal_evaluate(tmp_path):
-    from mtpg.analysis.evaluate import evaluate_graph
     from mtpg.engine.workload import layered_graphs
+    from mtpg.evolve.testing import evaluate_graph
 
     pop, roots = layered_graphs(np.random.default_rng(3), 2, teams=3, programs=4, instructions=5)
     for root in roots:

@@ -7,10 +7,13 @@ import warnings
 import numpy as np
 import pytest
 
-from mtpg.analysis import plots, plots_stats
-from mtpg.analysis.numbers import best_of, champion_path, run_numbers
-from mtpg.analysis.report import MixedRunsWarning, build_report
-from mtpg.analysis.runs import group_runs, load_run, normalise_scores, reference_best
+from mtpg.analysis.runs import hierarchical_complexity
+from mtpg.analysis.runs import score_figures as plots
+from mtpg.analysis.runs import statistics_figures as plots_stats
+from mtpg.analysis.runs.champions import champion_path
+from mtpg.analysis.runs.loading import group_runs, load_run, normalise_scores, reference_best
+from mtpg.analysis.runs.report import MixedRunsWarning, build_report
+from mtpg.analysis.runs.reported_numbers import best_of, run_numbers
 from mtpg.cli.main import main
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
 from mtpg.envs.reference import REFERENCE, measure_random, measure_time_optimal_cartcentering
@@ -170,7 +173,7 @@ FIGURES = [
     lambda g, n, p: plots.normalised_vs_single(g[0], n, p),
     lambda g, n, p: plots.normalised_vs_reference(g[0], n, p),
     lambda g, n, p: plots.ablations(g, n, p),
-    lambda g, n, p: plots.hierarchy(g[0], n, p),
+    lambda g, n, p: hierarchical_complexity.subset_complexity(g[0], n, p),
     lambda g, n, p: plots_stats.aggregate(
         g, n, {x.label: plots_stats.group_estimates(x, n) for x in g}, p
     ),
@@ -216,7 +219,7 @@ def test_normalisation_is_0_for_random_and_1_for_the_reference_controller():
 
 
 def test_mixture_warning_is_a_python_warning(runs, twelve, monkeypatch, tmp_path):
-    monkeypatch.setattr("mtpg.analysis.report.run_numbers", lambda run: 1 / 0)
+    monkeypatch.setattr("mtpg.analysis.runs.report.run_numbers", lambda run: 1 / 0)
     with pytest.warns(MixedRunsWarning), pytest.raises(ZeroDivisionError):
         build_report([runs[0], twelve], tmp_path / "x")  # warned before any number is made
 

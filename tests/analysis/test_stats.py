@@ -3,7 +3,7 @@ import itertools
 import numpy as np
 import pytest
 
-from mtpg.analysis.stats import aggregate_iqm, iqm, per_task_iqm, performance_profile
+from mtpg.analysis.runs.statistics import aggregate_iqm, iqm, per_task_iqm, performance_profile
 
 
 def test_iqm_is_the_mean_of_the_middle_half():

@@ -1,7 +1,7 @@
 import pytest
 
 from inside_graphs import single_team, writer_every_k
-from mtpg.analysis.replay import load_replay
+from mtpg.analysis.graph.replay import load_replay
 from mtpg.cli.main import main
 from mtpg.io.serialize import save_graph
 

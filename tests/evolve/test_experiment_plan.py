@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import sys
 
+from mtpg.ablations import label_of
 from mtpg.evolve import experiment
-from mtpg.evolve.experiment import LABELS, PlannedRun, execute, plan
+from mtpg.evolve.experiment import PlannedRun, execute, plan
 from mtpg.io.checkpoint import checkpoint_path
 
 
@@ -22,7 +23,7 @@ def test_plan_lists_seeds_then_each_ablation(tmp_path) -> None:
     assert [r.ablation for r in runs] == [None, None, "no-crossover", "no-memory", "no-hierarchy"]
     assert all(r.path.parent == tmp_path for r in runs)
     assert len(plan(tmp_path, 3, 2)) == 3 + 3 * 2
-    assert LABELS[None] == "TPG"
+    assert label_of(None) == "TPG"
 
 
 def make_run_dir(path, generations: list[int]) -> None:

@@ -3,7 +3,7 @@
 import re
 from pathlib import Path
 
-from mtpg.analysis.replay import SCHEMA_VERSION
+from mtpg.analysis.graph.replay import SCHEMA_VERSION
 from mtpg.io.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION
 from mtpg.io.serialize import GRAPH_FORMAT, GRAPH_VERSION, POPULATION_FORMAT, POPULATION_VERSION
 from mtpg.model.instructions import CONSTANTS, OP_NAMES, RegisterLayout, disassemble

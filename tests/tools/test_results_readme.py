@@ -58,8 +58,8 @@ def test_the_page_links_every_figure_it_draws_and_names_every_run(results):
 
 
 def test_the_page_quotes_the_numbers_of_the_report(results):
-    from mtpg.analysis.numbers import run_numbers
-    from mtpg.analysis.runs import load_run
+    from mtpg.analysis.runs.loading import load_run
+    from mtpg.analysis.runs.reported_numbers import run_numbers
 
     text = results_readme.build(results, analyze=False).read_text()
     for name in ("TPG-seed1", "TPG-NoMemory-seed1"):
@@ -69,8 +69,8 @@ def test_the_page_quotes_the_numbers_of_the_report(results):
 
 
 def test_the_page_gives_each_champion_test_return_with_its_interval(results):
-    from mtpg.analysis.numbers import run_numbers
-    from mtpg.analysis.runs import load_run
+    from mtpg.analysis.runs.loading import load_run
+    from mtpg.analysis.runs.reported_numbers import run_numbers
 
     text = results_readme.build(results, analyze=False).read_text()
     n = run_numbers(load_run(results / "runs" / "TPG-seed2"))

@@ -1,7 +1,7 @@
 """The colours of the section-6 figures, in one place so every figure agrees.
 
 Each task keeps one colour in every figure (graph pies, register bars, time series,
-videos); the section-5 figures of :mod:`mtpg.analysis.plots` colour runs, not tasks.
+videos); the section-5 figures of :mod:`mtpg.analysis.runs.score_figures` colour runs, not tasks.
 """
 
 from __future__ import annotations

@@ -37,7 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.page6 import build_analysis
+    from mtpg.analysis.graph.page import build_analysis
     from mtpg.cli.cmd_evaluate import resolve_graph
     from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError

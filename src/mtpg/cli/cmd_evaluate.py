@@ -35,33 +35,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def resolve_graph(target: Path):
-    """Loads the graph a path names: a graph file, or a run's all-task champion.
+    """Loads the graph a path names: a graph file, or a run's reported champion.
 
     For a run directory this is the champion the report shows
-    (:func:`mtpg.analysis.numbers.champion_path`: the all-task champion at the final test
-    point, chosen by training score), or the latest champion of a run without tests.
+    (:func:`mtpg.analysis.runs.champions.run_champion`).
 
     Returns:
         ``(population, root, meta, default task names)``.
     """
-    from mtpg.analysis.numbers import champion_path
-    from mtpg.analysis.runs import load_run
-    from mtpg.io.runconfig import read_run_config
-    from mtpg.io.rundir import TESTS_FILE, RunDir, champion_filename
     from mtpg.io.serialize import load_graph
 
     if target.is_dir():
+        from mtpg.analysis.runs.champions import run_champion
+        from mtpg.io.runconfig import read_run_config
+
         config = read_run_config(target)
-        tasks = list(config.evaluation.tasks)
-        path = RunDir(target).champions / champion_filename(tuple(tasks))
-        if (target / TESTS_FILE).is_file() and load_run(target).tests:
-            path = champion_path(load_run(target))
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: the run has no champion yet")
-        pop, root, meta = load_graph(path)
+        pop, root, meta = load_graph(run_champion(target))
         meta.setdefault("no_memory", config.evaluation.no_memory)  # the run's ablation
         meta.setdefault("test_episodes", config.evaluation.test_episodes)
-        return pop, root, meta, tasks
+        return pop, root, meta, list(config.evaluation.tasks)
     pop, root, meta = load_graph(target)
     from mtpg.envs.registry import PAPER_TASKS
 
@@ -70,14 +62,14 @@ def resolve_graph(target: Path):
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.evaluate import evaluate_graph
-    from mtpg.analysis.runs import normalise_scores
+    from mtpg.analysis.runs.loading import normalise_scores
     from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.protocol import N_TEST_EPISODES
     from mtpg.envs.tasks import MAX_STEPS
     from mtpg.envs.variants import known, spec_of
+    from mtpg.evolve.testing import evaluate_graph
     from mtpg.limits import check_evaluation_fits
 
     pop, root, meta, tasks = resolve_graph(Path(args.target))
@@ -150,18 +142,8 @@ def check_options(args: argparse.Namespace) -> None:
 
 
 def single_task_bests(target: Path, tasks: list[str]) -> dict[str, float]:
-    """Test score of each task's single-task champion at the run's final test point.
+    """The ``vs single`` denominators of a run (:func:`single_task_scores`), else empty."""
+    from mtpg.analysis.runs.champions import single_task_scores, tested_run
 
-    The denominators of ``vs single`` (:mod:`mtpg.analysis.numbers`): chosen by training
-    score, never by test score; empty for a graph file or a run without tests.
-    """
-    from mtpg.analysis.runs import load_run
-    from mtpg.io.rundir import TESTS_FILE
-
-    if not (target.is_dir() and (target / TESTS_FILE).is_file()):
-        return {}
-    run = load_run(target)
-    if not run.tests:
-        return {}
-    gen = run.final_generation
-    return {t: float(run.row(t, gen)[f"test_{t}"]) for t in tasks if t in run.tasks}
+    run = tested_run(target) if target.is_dir() else None
+    return {} if run is None else single_task_scores(run, tasks)

@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     import numpy as np
 
-    from mtpg.analysis.replay import replay_task
+    from mtpg.analysis.graph.replay import replay_task
     from mtpg.cli.cmd_evaluate import resolve_graph
     from mtpg.cli.cmd_train import task_list
     from mtpg.cli.main import UsageError
@@ -57,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     if args.video and Path(args.video).suffix not in (".gif", ".mp4"):
         raise UsageError(f"--video {args.video}: must end in .gif or .mp4")
     if args.video and Path(args.video).suffix == ".mp4":
-        from mtpg.analysis.replayvideo import ffmpeg_writer
+        from mtpg.analysis.graph.video import ffmpeg_writer
 
         ffmpeg_writer(args.fps)  # fail before the replay when ffmpeg is missing
     pop, root, meta, _ = resolve_graph(Path(args.target))
@@ -79,8 +79,8 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         print(f"wrote {replay.save(args.out)}")
     if args.video:
-        from mtpg.analysis.graphlayout import layout_graph
-        from mtpg.analysis.replayvideo import write_video
+        from mtpg.analysis.description.layout import layout_graph
+        from mtpg.analysis.graph.video import write_video
 
         frames = write_video(
             replay, layout_graph(pop, root), args.video, fps=args.fps, max_frames=args.max_frames

@@ -30,7 +30,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
     import warnings
 
-    from mtpg.analysis.report import MixedRunsWarning, build_report
+    from mtpg.analysis.runs.report import MixedRunsWarning, build_report
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MixedRunsWarning)

@@ -23,8 +23,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.graphinfo import describe_graph, graph_dot
-    from mtpg.analysis.graphlayout import render_svg
+    from mtpg.analysis.description.layout import render_svg
+    from mtpg.analysis.description.listing import describe_graph, graph_dot
     from mtpg.cli.cmd_evaluate import resolve_graph
 
     target = Path(args.target)

@@ -5,21 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-ABLATION_FLAGS = {
-    "no_crossover": "no-crossover",
-    "no_memory": "no-memory",
-    "no_hierarchy": "no-hierarchy",
-}
-#: What each ablation switch does (section 5.2), for ``--help``.
-ABLATION_HELP = {
-    "no_crossover": "ablation TPG-NoXover: children are mutated copies of one parent, never "
-    "crossovers "
-    "(team.p_crossover=0)",
-    "no_memory": "ablation TPG-NoMemory: memory banks zeroed before every program execution "
-    "(evaluation.no_memory=true)",
-    "no_hierarchy": "ablation TPG-NoHierarchy: action pointers always atomic, no graphs "
-    "(team.p_atomic=1)",
-}
+from mtpg.ablations import ABLATION_TABLE
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -72,8 +58,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="override any setting, e.g. --set team.n_elite=10; top-level fields take no "
         "section, e.g. --set checkpoint_interval=5 (repeatable; fields: mtpg.config)",
     )
-    for dest, name in ABLATION_FLAGS.items():
-        p.add_argument(f"--{name}", dest=dest, action="store_true", help=ABLATION_HELP[dest])
+    for abl in ABLATION_TABLE:
+        p.add_argument(abl.flag, dest=abl.dest, action="store_true", help=abl.help)
     where = p.add_mutually_exclusive_group()
     where.add_argument(
         "--out", metavar="RUN_DIR", help="new run directory (default: runs/<preset>-seed<seed>)"
@@ -112,8 +98,6 @@ def task_list(text: str, option: str = "--tasks") -> list[str]:
 
 def overrides(args: argparse.Namespace) -> list[str]:
     """The ``section.field=value`` overrides the options stand for."""
-    from mtpg.config import ABLATIONS
-
     out = list(args.set)
     if args.tasks is not None:
         names = task_list(args.tasks)
@@ -124,10 +108,7 @@ def overrides(args: argparse.Namespace) -> list[str]:
     for key in ("backend", "address"):
         if getattr(args, key) is not None:
             out.append(f'{key}="{getattr(args, key)}"')
-    for dest, name in ABLATION_FLAGS.items():
-        if getattr(args, dest):
-            key, value = ABLATIONS[name]
-            out.append(f"{key}={str(value).lower()}")
+    out += [abl.override for abl in ABLATION_TABLE if getattr(args, abl.dest)]
     return out
 
 

@@ -14,18 +14,10 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from mtpg.config import ABLATIONS
+from mtpg.ablations import ABLATION_TABLE, FULL_ALGORITHM, ablation
 from mtpg.evolve.stopping import GracefulStop, StopNow
 from mtpg.io.checkpoint import list_checkpoints
 from mtpg.io.rundir import is_run_dir
-
-#: Directory-name prefix of each experiment (the labels of paper section 5.2).
-LABELS = {
-    None: "TPG",
-    "no-crossover": "TPG-NoXover",
-    "no-memory": "TPG-NoMemory",
-    "no-hierarchy": "TPG-NoHierarchy",
-}
 
 
 @dataclass(frozen=True)
@@ -35,7 +27,8 @@ class PlannedRun:
     Attributes:
         path: Its run directory.
         seed: Its seed.
-        ablation: The ablation switch, or None for the full algorithm.
+        ablation: The ablation switch (:data:`mtpg.ablations.ABLATION_TABLE`), or None for
+            the full algorithm.
     """
 
     path: Path
@@ -54,7 +47,7 @@ class PlannedRun:
         base = [sys.executable, "-m", "mtpg", "train", "--quiet", "--workers", str(workers)]
         if is_run_dir(self.path):
             return [*base, "--resume", str(self.path), "--generations", str(generations)]
-        extra = [f"--{self.ablation}"] if self.ablation else []
+        extra = [ablation(self.ablation).flag] if self.ablation else []
         return [
             *base,
             *train_args,
@@ -69,12 +62,15 @@ class PlannedRun:
 
 
 def plan(folder: Path, seeds: int, ablation_seeds: int) -> list[PlannedRun]:
-    """The runs of an experiment: ``seeds`` full runs and ``ablation_seeds`` per ablation."""
-    runs = [PlannedRun(folder / f"TPG-seed{k}", k, None) for k in range(seeds)]
-    for switch in ABLATIONS:
+    """The runs of an experiment: ``seeds`` full runs and ``ablation_seeds`` per ablation.
+
+    Each run directory is named by its experiment label (:mod:`mtpg.ablations`) and seed,
+    ``TPG-seed0``, ``TPG-NoXover-seed0``, ...
+    """
+    runs = [PlannedRun(folder / f"{FULL_ALGORITHM}-seed{k}", k, None) for k in range(seeds)]
+    for abl in ABLATION_TABLE:
         runs += [
-            PlannedRun(folder / f"{LABELS[switch]}-seed{k}", k, switch)
-            for k in range(ablation_seeds)
+            PlannedRun(folder / f"{abl.name}-seed{k}", k, abl.switch) for k in range(ablation_seeds)
         ]
     return runs
 

@@ -15,10 +15,11 @@ from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.evaluator import make_evaluator
-from mtpg.envs.protocol import held_out_seeds, resampled_training_seeds, validation_seeds
+from mtpg.envs.protocol import resampled_training_seeds, validation_seeds
 from mtpg.envs.variants import spec_of
 from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
+from mtpg.evolve.testing import play_test
 from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
@@ -219,22 +220,24 @@ class Trainer:
     def held_out_scores(self) -> list[dict[str, float | int | str]]:
         """Tests the champion of every task subset on held-out episodes of every task.
 
-        Each distinct champion plays ``test_episodes`` episodes of each active task (seeds
-        from :func:`held_out_seeds`); nothing random is drawn, so testing leaves the run
-        unchanged.
+        Each distinct champion plays the test (:func:`mtpg.evolve.testing.play_test`):
+        ``test_episodes`` held-out episodes of each active task; nothing random is drawn,
+        so testing leaves the run unchanged.
 
         Returns:
             One row per subset (``held_out_columns`` keys), in subset order.
         """
         st, ev = self.state, self.config.evaluation
         roots = sorted(set(st.champions))
-        table = Episodes.grid(self.task_ids, held_out_seeds(ev.test_episodes))
-        cp = compile_population(st.population)
-        returns, result = self.evaluator.evaluate(cp, roots, table, ev.no_memory)
-        n = len(self.task_ids)
-        means = returns.reshape(len(roots), n, ev.test_episodes).mean(axis=2)
-        per_root = result.teams.reshape(len(roots), -1).sum(axis=1)
-        steps = result.steps.reshape(len(roots), -1).sum(axis=1)
+        test = play_test(
+            st.population,
+            roots,
+            self.task_ids,
+            ev.test_episodes,
+            no_memory=ev.no_memory,
+            evaluate=self.evaluator.evaluate,
+        )
+        means, per_decision = test.mean_returns(), test.teams_per_decision()
         rows = []
         for k, root in enumerate(st.champions):
             i = roots.index(root)
@@ -243,7 +246,7 @@ class Trainer:
                 "subset": "+".join(self.subset_names(k)),
                 "root": root,
                 "graph_teams": len(st.population.reachable(root)),
-                "teams_per_decision": float(per_root[i] / steps[i]),
+                "teams_per_decision": float(per_decision[i]),
             }
             for j, task in enumerate(self.task_ids):
                 row[f"test_{spec_of(task).name}"] = float(means[i, j])

@@ -1,22 +1,25 @@
 """``mtpg report``: section 5's figures and statistics across seeds, PNGs plus one HTML page.
 
-Every number comes from :mod:`mtpg.analysis.numbers` (the same definitions ``mtpg
-evaluate`` uses); runs are grouped by configuration (:func:`mtpg.analysis.runs.group_runs`)
-and a mixture of configurations beyond the ablation switches raises
-:class:`MixedRunsWarning`.
+Every number comes from :mod:`mtpg.analysis.runs.reported_numbers` (the same definitions
+``mtpg evaluate`` uses); runs are grouped by configuration
+(:func:`mtpg.analysis.runs.loading.group_runs`) and a mixture of configurations beyond the
+ablation switches raises :class:`MixedRunsWarning`.
 """
 
 from __future__ import annotations
 
-import base64
 import html
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis import plots, plots_stats
-from mtpg.analysis.numbers import (
+from mtpg.analysis import html as pages
+from mtpg.analysis.runs import score_figures, statistics_figures
+from mtpg.analysis.runs.hierarchical_complexity import subset_complexity
+from mtpg.analysis.runs.loading import RunData, RunGroup, group_runs, load_run, reference_best
+from mtpg.analysis.runs.reported_numbers import (
     BEST_RUN_RULE,
     SINGLE_RULE,
     RunNumbers,
@@ -24,7 +27,6 @@ from mtpg.analysis.numbers import (
     describe,
     run_numbers,
 )
-from mtpg.analysis.runs import RunData, RunGroup, group_runs, load_run, reference_best
 
 
 class MixedRunsWarning(UserWarning):
@@ -58,7 +60,7 @@ def _stats_table(groups: list[RunGroup], estimates, tasks) -> str:
         body += f"<tr><td>{html.escape(g.label)}</td><td>{len(g.runs)}</td>{cells}</tr>"
     return (
         "<h2>Across seeds: IQM [95% CI] of the normalised test score</h2>"
-        f"<p>{html.escape(plots_stats.STATS_NOTE)} Normalised: 0 = random play, "
+        f"<p>{html.escape(statistics_figures.STATS_NOTE)} Normalised: 0 = random play, "
         "1 = reference best.</p>"
         f"<table><tr><th>experiment</th><th>runs</th>{head}</tr>{body}</table>"
     )
@@ -81,6 +83,11 @@ def _runs_list(groups: list[RunGroup], numbers: dict[Path, RunNumbers]) -> str:
     return "<ul>" + "".join(items) + "</ul>"
 
 
+Numbers = dict[Path, RunNumbers]
+#: A figure of the report: file name, title, and how to draw it into a path.
+Figure = tuple[str, str, Callable[[Path], Path]]
+
+
 def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> Path:
     """Writes the PNG figures and ``index.html`` for one or more runs.
 
@@ -95,34 +102,61 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
     Raises:
         ValueError: If the runs are on different tasks or have no test results.
     """
+    runs = _load_runs(run_dirs)
+    groups, mixed = group_runs(runs)
+    for text in mixed:
+        warnings.warn(text, MixedRunsWarning, stacklevel=2)
+    numbers = {r.path: run_numbers(r) for r in runs}
+    estimates = {g.label: statistics_figures.group_estimates(g, numbers) for g in groups}
+    out = Path(out) if out is not None else runs[0].path / "report"
+    out.mkdir(parents=True, exist_ok=True)
+    sections = [
+        pages.figure(draw(out / name), title)
+        for name, title, draw in _figures(groups, numbers, estimates)
+    ]
+    ordered = [(g.label, numbers[r.path]) for g in groups for r in g.runs]
+    warn_html = "".join(f'<p class="warn">Warning: {html.escape(w)}</p>' for w in mixed)
+    body = (
+        f"<h1>mtpg report</h1>{warn_html}\n"
+        f"<p>{html.escape(describe([n for _, n in ordered]))} {html.escape(BEST_RUN_RULE)}.</p>\n"
+        f"{_runs_list(groups, numbers)}\n"
+        f"{''.join(_tables(groups, ordered, estimates, runs[0].tasks))}\n"
+        f"{''.join(sections)}"
+    )
+    index = out / "index.html"
+    page = pages.page("mtpg report", body, ".warn{color:#a00;font-weight:bold}")
+    index.write_text(page, encoding="utf-8")
+    return index
+
+
+def _load_runs(run_dirs: list[str | Path]) -> list[RunData]:
+    """The runs, refusing runs on different tasks."""
     runs: list[RunData] = [load_run(p) for p in run_dirs]
     tasks = runs[0].tasks
     for run in runs:
         if run.tasks != tasks:
             raise ValueError(f"{run.path}: tasks {run.tasks} differ from {tasks}")
-    groups, mixed = group_runs(runs)
-    for text in mixed:
-        warnings.warn(text, MixedRunsWarning, stacklevel=2)
-    numbers = {r.path: run_numbers(r) for r in runs}
-    estimates = {g.label: plots_stats.group_estimates(g, numbers) for g in groups}
-    out = Path(out) if out is not None else runs[0].path / "report"
-    out.mkdir(parents=True, exist_ok=True)
+    return runs
+
+
+def _figures(groups: list[RunGroup], numbers: Numbers, estimates) -> list[Figure]:
+    """The report's figures in page order: Figs. 4-6, 7 (several experiments), 8, statistics."""
     main = groups[0]
-    figures = [
+    figures: list[Figure] = [
         (
             "learning_curves.png",
             "Learning curves (Fig. 4)",
-            lambda p: plots.learning_curves(main, numbers, p),
+            lambda p: score_figures.learning_curves(main, numbers, p),
         ),
         (
             "normalised_vs_single.png",
             "Against single-task champions (Fig. 5)",
-            lambda p: plots.normalised_vs_single(main, numbers, p),
+            lambda p: score_figures.normalised_vs_single(main, numbers, p),
         ),
         (
             "normalised_vs_reference.png",
             "Against the reference best (Fig. 6)",
-            lambda p: plots.normalised_vs_reference(main, numbers, p),
+            lambda p: score_figures.normalised_vs_reference(main, numbers, p),
         ),
     ]
     if len(groups) > 1:
@@ -130,37 +164,32 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
             (
                 "ablations.png",
                 "Experiments and ablations (Fig. 7)",
-                lambda p: plots.ablations(groups, numbers, p),
+                lambda p: score_figures.ablations(groups, numbers, p),
             )
         )
-    figures += [
+    return figures + [
         (
             "hierarchy.png",
             "Teams per decision by task subset (Fig. 8)",
-            lambda p: plots.hierarchy(main, numbers, p),
+            lambda p: subset_complexity(main, numbers, p),
         ),
         (
             "aggregate.png",
             "Across seeds: interquartile mean with 95% CIs",
-            lambda p: plots_stats.aggregate(groups, numbers, estimates, p),
+            lambda p: statistics_figures.aggregate(groups, numbers, estimates, p),
         ),
         (
             "performance_profile.png",
             "Across seeds: performance profile",
-            lambda p: plots_stats.profile(groups, numbers, p),
+            lambda p: statistics_figures.profile(groups, numbers, p),
         ),
     ]
-    sections = []
-    for name, title, draw in figures:
-        png = draw(out / name)
-        data = base64.b64encode(png.read_bytes()).decode("ascii")
-        sections.append(
-            f'<h2>{html.escape(title)}</h2><img alt="{html.escape(title)}" '
-            f'src="data:image/png;base64,{data}">'
-        )
-    ordered = [(g.label, numbers[r.path]) for g in groups for r in g.runs]
+
+
+def _tables(groups, ordered: list[tuple[str, RunNumbers]], estimates, tasks) -> list[str]:
+    """The statistics table, then the test, normalised and denominator tables of every run."""
     ref = reference_best(tasks)
-    tables = [
+    return [
         _stats_table(groups, estimates, tasks),
         _table(
             "Test return of each run's all-task champion",
@@ -191,19 +220,3 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
             [(g, n.run.name, n.single) for g, n in ordered],
         ),
     ]
-    warn_html = "".join(f'<p class="warn">Warning: {html.escape(w)}</p>' for w in mixed)
-    page = f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>mtpg report</title>
-<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}}img{{max-width:100%}}
-table{{border-collapse:collapse}}td,th{{border:1px solid #ccc;padding:3px 8px;text-align:right}}
-.warn{{color:#a00;font-weight:bold}}</style></head><body>
-<h1>mtpg report</h1>{warn_html}
-<p>{html.escape(describe([n for _, n in ordered]))} {html.escape(BEST_RUN_RULE)}.</p>
-{_runs_list(groups, numbers)}
-{"".join(tables)}
-{"".join(sections)}
-</body></html>
-"""
-    index = out / "index.html"
-    index.write_text(page, encoding="utf-8")
-    return index

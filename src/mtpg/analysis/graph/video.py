@@ -11,10 +11,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from mtpg.analysis.figures6 import pyplot
-from mtpg.analysis.graphlayout import GraphDrawing, GraphLayout
+from mtpg.analysis.description.layout import GraphDrawing, GraphLayout
+from mtpg.analysis.graph.replay import Replay
 from mtpg.analysis.palette import task_colour
-from mtpg.analysis.replay import Replay
+from mtpg.analysis.plotting import pyplot
 from mtpg.envs.render import make_renderer
 
 #: File endings of the formats written.

@@ -2,8 +2,9 @@
 
 The layout is layered by depth (shortest distance from the root, which is on top), using
 networkx's ``multipartite_layout``; networkx is a well-kept graph library, so the project
-does not maintain its own graph algorithms. DOT (:func:`mtpg.analysis.graphinfo.graph_dot`)
-is written beside a picture, and rendered to SVG only when GraphViz's ``dot`` is on PATH.
+does not maintain its own graph algorithms. DOT
+(:func:`mtpg.analysis.description.listing.graph_dot`) is written beside a picture, and
+rendered to SVG only when GraphViz's ``dot`` is on PATH.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.graphinfo import index_graph
+from mtpg.analysis.description.numbering import index_graph
 from mtpg.analysis.palette import IDLE_COLOUR, PATH_COLOUR
 from mtpg.model.graph import Population
 
@@ -85,12 +86,26 @@ class GraphDrawing:
         pie_colours: list[str] | None = None,
         font_size: float = 9,
     ):
-        from matplotlib.patches import Circle, FancyArrowPatch, Wedge
-
         self.ax = ax
         self.layout = layout
+        self.arrows = self._draw_arrows()
+        self.nodes = self._draw_nodes(pies, pie_colours, font_size)
         r = layout.radius
-        self.arrows: dict[tuple[int, int], FancyArrowPatch] = {}
+        pad = r * 2.2
+        ax.set_xlim(layout.pos[:, 0].min() - pad, layout.pos[:, 0].max() + pad)
+        ax.set_ylim(layout.pos[:, 1].min() - pad, layout.pos[:, 1].max() + pad)
+        ax.set_aspect("equal")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        for spine in ax.spines.values():
+            spine.set_visible(False)
+
+    def _draw_arrows(self) -> dict:
+        """One arrow per edge (curved when it points up or sideways), by ``(from, to)``."""
+        from matplotlib.patches import FancyArrowPatch
+
+        ax, layout, r = self.ax, self.layout, self.layout.radius
+        arrows: dict[tuple[int, int], FancyArrowPatch] = {}
         for a, b in layout.edges:
             p, q = layout.pos[a - 1], layout.pos[b - 1]
             upward = layout.depth[b - 1] <= layout.depth[a - 1]
@@ -109,8 +124,15 @@ class GraphDrawing:
                 zorder=1,
             )
             ax.add_patch(arrow)
-            self.arrows[(a, b)] = arrow
-        self.nodes = []
+            arrows[(a, b)] = arrow
+        return arrows
+
+    def _draw_nodes(self, pies, pie_colours, font_size: float) -> list:
+        """One circle per team (a pie when ``pies`` is given) with its number."""
+        from matplotlib.patches import Circle
+
+        ax, layout, r = self.ax, self.layout, self.layout.radius
+        nodes = []
         for k, (x, y) in enumerate(layout.pos):
             fill = "white" if pies is not None else IDLE_COLOUR
             idle = pies is not None and pies[k].sum() == 0
@@ -124,25 +146,9 @@ class GraphDrawing:
                 zorder=2,
             )
             ax.add_patch(circle)
-            self.nodes.append(circle)
+            nodes.append(circle)
             if pies is not None and pies[k].sum() > 0:
-                start = 90.0
-                for frac, colour in zip(pies[k], pie_colours or [], strict=False):
-                    if frac <= 0:
-                        continue
-                    ax.add_patch(
-                        Wedge(
-                            (x, y),
-                            r,
-                            start,
-                            start + 360 * frac,
-                            facecolor=colour,
-                            edgecolor="white",
-                            lw=0.5,
-                            zorder=3,
-                        )
-                    )
-                    start += 360 * frac
+                _pie(ax, (x, y), r, pies[k], pie_colours or [])
             ax.text(
                 x,
                 y - r * 1.15 if pies is not None else y,
@@ -153,14 +159,7 @@ class GraphDrawing:
                 fontweight="bold",
                 zorder=4,
             )
-        pad = r * 2.2
-        ax.set_xlim(layout.pos[:, 0].min() - pad, layout.pos[:, 0].max() + pad)
-        ax.set_ylim(layout.pos[:, 1].min() - pad, layout.pos[:, 1].max() + pad)
-        ax.set_aspect("equal")
-        ax.set_xticks([])
-        ax.set_yticks([])
-        for spine in ax.spines.values():
-            spine.set_visible(False)
+        return nodes
 
     def highlight(self, path: list[int]) -> list:
         """Colours a decision path (team numbers in visiting order); returns changed artists."""
@@ -174,6 +173,29 @@ class GraphDrawing:
             arrow.set_color(PATH_COLOUR if live else "0.75")
             arrow.set_linewidth(2.2 if live else 0.8)
         return self.nodes + list(self.arrows.values())
+
+
+def _pie(ax, centre: tuple[float, float], r: float, fractions, colours: list[str]) -> None:
+    """Slices of a node, counter-clockwise from the top, one per non-zero fraction."""
+    from matplotlib.patches import Wedge
+
+    start = 90.0
+    for frac, colour in zip(fractions, colours, strict=False):
+        if frac <= 0:
+            continue
+        ax.add_patch(
+            Wedge(
+                centre,
+                r,
+                start,
+                start + 360 * frac,
+                facecolor=colour,
+                edgecolor="white",
+                lw=0.5,
+                zorder=3,
+            )
+        )
+        start += 360 * frac
 
 
 def _ends(p: np.ndarray, q: np.ndarray, r: float, rad: float) -> tuple[tuple, tuple]:

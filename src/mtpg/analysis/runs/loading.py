@@ -2,7 +2,7 @@
 
 ``normalised = (score - random) / (best - random)``: 0 is random play; ``best`` is either
 a single-task champion (Figs. 5 and 7) or the reference best of the task (Fig. 6); see
-:mod:`mtpg.analysis.numbers` for which champion every reported number comes from.
+:mod:`mtpg.analysis.runs.reported_numbers` for which champion every reported number comes from.
 
 Runs are grouped by configuration: two runs belong to one group when their configurations
 are equal in everything but the seed and the settings that do not change what a run
@@ -22,7 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from mtpg.config import ABLATIONS, RunConfig, to_dict
+from mtpg.ablations import ABLATION_FIELDS, experiment_label
+from mtpg.config import RunConfig, to_dict
 from mtpg.envs.reference import normalise, reference_of
 from mtpg.envs.variants import resolve
 from mtpg.io.runconfig import read_run_config
@@ -30,19 +31,6 @@ from mtpg.io.rundir import TESTS_FILE
 
 #: Settings that do not change what a run computes: ignored when grouping.
 NOT_GROUPED = ("seed", "workers", "checkpoint_interval", "backend", "address", "dask_workers")
-#: The ablation switches (``section.field``): groups differing only in these are comparable.
-ABLATION_FIELDS = tuple(key for key, _ in ABLATIONS.values())
-
-
-def experiment_label(config: RunConfig) -> str:
-    """Names the ablation a configuration stands for (section 5.2), or ``"TPG"``."""
-    if config.evaluation.no_memory:
-        return "TPG-NoMemory"
-    if config.team.p_atomic == 1.0:
-        return "TPG-NoHierarchy"
-    if config.team.p_crossover == 0.0:
-        return "TPG-NoXover"
-    return "TPG"
 
 
 @dataclass
@@ -53,7 +41,7 @@ class RunData:
         path: The run directory.
         config: Its configuration.
         tests: ``tests.csv`` rows with numbers parsed.
-        label: Experiment label (see :func:`experiment_label`).
+        label: Experiment label (:func:`mtpg.ablations.experiment_label`).
     """
 
     path: Path

@@ -1,14 +1,14 @@
 """What happens inside a graph during replays (paper section 6), as plain arrays.
 
-Every function takes :class:`~mtpg.analysis.replay.Replay` objects and returns NumPy arrays
-or dicts of them; :mod:`mtpg.analysis.figures6` only draws these.
+Every function takes :class:`~mtpg.analysis.graph.replay.Replay` objects and returns NumPy arrays
+or dicts of them; :mod:`mtpg.analysis.graph.figures` only draws these.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from mtpg.analysis.replay import Replay
+from mtpg.analysis.graph.replay import Replay
 from mtpg.envs.registry import TASKS
 from mtpg.envs.variants import spec_of
 

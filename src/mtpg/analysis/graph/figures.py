@@ -1,4 +1,4 @@
-"""The figures of paper section 6, drawn from the data of :mod:`mtpg.analysis.inside`.
+"""The figures of paper section 6 (Figs. 9-12), drawn from :mod:`mtpg.analysis.graph.measures`.
 
 Each function draws one PNG from arrays it is given and computes nothing of its own.
 Task colours come from :mod:`mtpg.analysis.palette`.
@@ -10,31 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.graphlayout import GraphDrawing, GraphLayout
+from mtpg.analysis.description.layout import GraphDrawing, GraphLayout
 from mtpg.analysis.palette import (
     ACTION_COLOURS,
     CONTINUOUS_CMAP,
     PASSED_COLOUR,
     task_colour,
 )
-
-DPI = 110
-
-
-def pyplot():
-    """The pyplot module of matplotlib, on the file-only Agg backend."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path: Path) -> Path:
-    fig.savefig(path, dpi=DPI)
-    pyplot().close(fig)
-    return Path(path)
+from mtpg.analysis.plotting import pyplot, save
 
 
 def _task_legend(fig_or_ax, tasks, **kw) -> None:
@@ -65,7 +48,7 @@ def team_graph(layout: GraphLayout, visits: dict, path: Path, title: str) -> Pat
         color="0.3",
     )
     fig.tight_layout(rect=(0, 0.1, 1, 0.93))
-    return _save(fig, path)
+    return save(fig, path)
 
 
 def register_access(access: dict, path: Path, title: str) -> Path:
@@ -95,7 +78,7 @@ def register_access(access: dict, path: Path, title: str) -> Path:
     ax.set_title(title, fontsize=11)
     fig.legend(*ax.get_legend_handles_labels(), fontsize=7, ncol=len(tasks), loc="lower center")
     fig.tight_layout(rect=(0, 0.07, 1, 1))
-    return _save(fig, path)
+    return save(fig, path)
 
 
 def time_series(task: str, series: dict, prediction: dict, path: Path, title: str) -> Path:
@@ -147,7 +130,7 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
     ax.set_xlabel("time step")
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
-    return _save(fig, path)
+    return save(fig, path)
 
 
 def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path:
@@ -217,43 +200,4 @@ def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path
     if dec["continuous"] and mappable is not None:
         cax = fig.add_axes((0.89, 0.2, 0.02, 0.6))
         fig.colorbar(mappable, cax=cax, label="a_c of the step (coloured: final team)")
-    return _save(fig, path)
-
-
-def run_hierarchy(stats: dict, means: dict, path: Path, title: str) -> Path:
-    """Fig. 8 across a run: teams per decision of every subset champion, by subset size."""
-    plt = pyplot()
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-    last = stats["test_generation"] == stats["final_generation"]
-    sizes = stats["subset_size"][last]
-    jitter = (np.arange(len(sizes)) % 7 - 3) * 0.04
-    a.scatter(sizes + jitter, stats["teams_per_decision"][last], s=16, color="0.3")
-    a.set_xlabel("number of tasks in the subset")
-    a.set_ylabel("teams visited per decision (test)")
-    a.set_title(f"Subset champions at generation {int(stats['final_generation'])}", fontsize=10)
-    a.set_xticks(np.unique(stats["subset_size"]))
-    cmap = plt.get_cmap("viridis")
-    n = len(means["sizes"])
-    for i, size in enumerate(means["sizes"]):
-        b.plot(
-            means["generations"],
-            means["mean"][i],
-            color=cmap(i / max(n - 1, 1)),
-            marker=".",
-            label=f"{size} task{'s' if size > 1 else ''}",
-        )
-    if len(stats["generation"]):
-        b.plot(
-            stats["generation"],
-            stats["population_teams_per_decision"],
-            color="0.6",
-            ls=":",
-            label="whole population (training)",
-        )
-    b.set_xlabel("generation")
-    b.set_ylabel("teams visited per decision\n(mean over subset champions)")
-    b.set_title("Over the run, by subset size", fontsize=10)
-    b.legend(fontsize=7, ncol=2)
-    fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    return _save(fig, path)
+    return save(fig, path)

@@ -1,8 +1,8 @@
 """Figures of the statistics across seeds: IQM with 95% CIs, and performance profiles.
 
 Scores are the reference-normalised test scores of each run's final all-task champion
-(:mod:`mtpg.analysis.numbers`); reference normalisation is defined for every task and run,
-unlike normalisation by a single-task champion that may equal random play.
+(:mod:`mtpg.analysis.runs.reported_numbers`); reference normalisation is defined for every
+task and run, unlike normalisation by a single-task champion that may equal random play.
 """
 
 from __future__ import annotations
@@ -11,10 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis import stats
-from mtpg.analysis.numbers import RunNumbers, describe
-from mtpg.analysis.plots import finish, pyplot
-from mtpg.analysis.runs import RunGroup
+from mtpg.analysis.plotting import finish, pyplot
+from mtpg.analysis.runs import statistics as stats
+from mtpg.analysis.runs.loading import RunGroup
+from mtpg.analysis.runs.reported_numbers import RunNumbers, describe
 
 STATS_NOTE = (
     "IQM = interquartile mean (mean of the middle 50% of scores); bars: 95% stratified "

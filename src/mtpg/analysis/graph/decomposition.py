@@ -4,14 +4,14 @@ For one task's replay, each team gets the points ``(observed variable, hidden ve
 of the steps at which it was visited; a point is *final* when the team chose the action
 at that step (it is then coloured by that action), otherwise the team passed execution
 on (grey). The observed variable is the task's first input ``s[0]``; the velocity is the
-state slot of :data:`mtpg.analysis.inside.HIDDEN_VELOCITY`.
+state slot of :data:`mtpg.analysis.graph.measures.HIDDEN_VELOCITY`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from mtpg.analysis.replay import Replay
+from mtpg.analysis.graph.replay import Replay
 from mtpg.envs.variants import spec_of
 
 

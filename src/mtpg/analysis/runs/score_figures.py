@@ -1,55 +1,28 @@
-"""The figures of paper section 5 from run directories (matplotlib, Agg backend).
+"""The score figures of paper section 5 (Figs. 4-7) from run directories (matplotlib, Agg).
 
 Every figure states under its plot which champion it shows (selected on training scores,
 at which generation), on how many held-out episodes, and what 0 and 1 mean
-(:mod:`mtpg.analysis.numbers`).
+(:mod:`mtpg.analysis.runs.reported_numbers`).
 """
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.numbers import (
+from mtpg.analysis.plotting import finish, pyplot
+from mtpg.analysis.runs.loading import RunGroup, normalise_scores, reference_best
+from mtpg.analysis.runs.reported_numbers import (
     BEST_RUN_RULE,
     SINGLE_RULE,
     RunNumbers,
     best_of,
     describe,
 )
-from mtpg.analysis.runs import RunGroup, normalise_scores, reference_best
 from mtpg.envs.protocol import describe_held_out
 
 Numbers = dict[Path, RunNumbers]  # run directory -> its numbers
-
-
-def pyplot():
-    """The pyplot module of matplotlib on the file-only Agg backend."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def finish(fig, path: Path, caption: str, legend_rows: int = 0) -> Path:
-    """Adds the caption (what is shown, how chosen) under the axes and saves the figure."""
-    text = "\n".join(
-        textwrap.wrap(caption, width=int(fig.get_figwidth() * 15), break_on_hyphens=False)
-    )
-    lines = text.count("\n") + 1
-    caption_top = (0.16 * lines + 0.1) / fig.get_figheight()
-    for legend in fig.legends:  # a figure legend sits between the plots and the caption
-        legend.set_bbox_to_anchor((0.5, caption_top), transform=fig.transFigure)
-    bottom = caption_top + 0.3 * legend_rows / fig.get_figheight()
-    fig.text(0.01, 0.01, text, fontsize=7, va="bottom", ha="left", color="0.25")
-    fig.tight_layout(rect=(0, bottom, 1, 1))
-    fig.savefig(path, dpi=110)
-    pyplot().close(fig)
-    return path
 
 
 def _task_axis(ax, tasks: tuple[str, ...]) -> None:
@@ -234,48 +207,5 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
         f"{ref.run.name} (best run of {groups[0].label}) at generation {ref.generation}, "
         f"selected by training score; n/a where that champion is no better than random. "
         f"Best run of each experiment: {BEST_RUN_RULE.removeprefix('Best run = ')}."
-    )
-    return finish(fig, path, caption)
-
-
-def hierarchy(group: RunGroup, numbers: Numbers, path: Path) -> Path:
-    """Fig. 8: teams visited per decision by the champion of every task subset.
-
-    One column per subset (ordered by size); points: minimum, median and maximum over runs
-    at the final test point, as in the paper.
-    """
-    plt = pyplot()
-    runs = group.runs
-    tasks = runs[0].tasks
-    subsets = sorted(
-        {str(r["subset"]) for r in runs[0].tests},
-        key=lambda s: (s.count("+"), [tasks.index(t) for t in s.split("+")]),
-    )
-    values = np.array(
-        [
-            [float(run.row(s, numbers[run.path].generation)["teams_per_decision"]) for s in subsets]
-            for run in runs
-        ]
-    )
-    xs = np.arange(len(subsets))
-    fig, ax = plt.subplots(figsize=(max(6.0, 0.28 * len(subsets) + 3), 5))
-    ax.scatter(xs, values.max(axis=0), marker="^", color="tab:red", s=18, label="max over runs")
-    ax.scatter(
-        xs, np.median(values, axis=0), marker="o", color="black", s=18, label="median over runs"
-    )
-    ax.scatter(xs, values.min(axis=0), marker="v", color="tab:blue", s=18, label="min over runs")
-    ax.set_xticks(xs)
-    ax.set_xticklabels(
-        ["+".join(str(tasks.index(t)) for t in s.split("+")) for s in subsets],
-        rotation=90 if len(subsets) > 12 else 0,
-        fontsize=7,
-    )
-    ax.set_xlabel("task subset (" + ", ".join(f"{k} = {t}" for k, t in enumerate(tasks)) + ")")
-    ax.set_ylabel("teams visited per decision\n(mean over test steps)")
-    ax.set_title(f"Hierarchical complexity of each subset's champion: {group.label}")
-    ax.legend(fontsize=7)
-    caption = (
-        f"{describe([numbers[r.path] for r in runs]).replace('All-task c', 'Each subset c')} "
-        f"Teams per decision counted over those test episodes of every task; {len(runs)} run(s)."
     )
     return finish(fig, path, caption)

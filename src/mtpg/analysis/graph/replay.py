@@ -5,7 +5,7 @@ A replay plays the same held-out episodes as ``mtpg evaluate`` (seeds from
 decisions of the batch kernel, so the returns are equal.
 
 ``.npz`` schema (version 1). ``N`` steps over all episodes, ``E`` episodes, teams, banks
-and programs numbered as in :mod:`mtpg.analysis.graphinfo` (team 1 is the root). Ragged
+and programs numbered as in :mod:`mtpg.analysis.description.numbering` (team 1 is the root). Ragged
 per-step lists are flat arrays with offsets: the entries of step ``i`` are
 ``x[x_offsets[i]:x_offsets[i + 1]]``.
 
@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.graphinfo import effective_instruction_map, index_graph
+from mtpg.analysis.description.numbering import effective_instruction_map, index_graph
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs import make_episodes
@@ -195,6 +195,36 @@ def replay_observations(
     return _assemble(pop, root, cp, [trace], header, no_memory, 1)
 
 
+def _dense_numbers(index, cp: CompiledPopulation, m: int) -> tuple[np.ndarray, ...]:
+    """Team and bank numbers of the compiled (dense) indices, and the graph's memory columns."""
+    team_number = np.zeros(len(cp.team_ids), dtype=np.int64)
+    for k, tid in enumerate(index.teams):
+        team_number[cp.team_index(tid)] = k + 1
+    bank_number = np.zeros(len(cp.bank_ids), dtype=np.int64)
+    columns = []
+    for k, bid in enumerate(index.banks):
+        dense = cp.bank_index(bid)
+        bank_number[dense] = k + 1
+        columns.extend(range(dense * m, (dense + 1) * m))
+    return team_number, bank_number, np.array(columns, dtype=np.int64)
+
+
+def _memory_accesses(
+    log: np.ndarray, bank_number: np.ndarray, no_memory: bool, n: int
+) -> dict[str, np.ndarray]:
+    """The ``mem_*`` arrays of one episode's memory log (see the schema for the ages)."""
+    t, last = log[:, 0], log[:, 4]
+    age = np.where(last >= 0, t - last, 0 if no_memory else t + 1)
+    return {
+        "mem_bank": bank_number[log[:, 1]],
+        "mem_register": log[:, 2],
+        "mem_is_write": log[:, 3].astype(bool),
+        "mem_age": age.astype(np.int64),
+        "mem_from_reset": last < 0,
+        "mem_offsets": _offsets(t, n),
+    }
+
+
 def _assemble(
     pop: Population,
     root: int,
@@ -207,16 +237,7 @@ def _assemble(
     """Joins traced episodes into the arrays of the schema, with graph numbering."""
     index = index_graph(pop, root)
     m = pop.layout.n_memory
-    team_number = np.zeros(len(cp.team_ids), dtype=np.int64)
-    for k, tid in enumerate(index.teams):
-        team_number[cp.team_index(tid)] = k + 1
-    bank_number = np.zeros(len(cp.bank_ids), dtype=np.int64)
-    columns = []
-    for k, bid in enumerate(index.banks):
-        dense = cp.bank_index(bid)
-        bank_number[dense] = k + 1
-        columns.extend(range(dense * m, (dense + 1) * m))
-    columns = np.array(columns, dtype=np.int64)
+    team_number, bank_number, columns = _dense_numbers(index, cp, m)
     instr_prog, instr_pos = effective_instruction_map(pop, cp.program_ids)
     parts: dict[str, list[np.ndarray]] = {}
 
@@ -246,15 +267,8 @@ def _assemble(
         add("instr_program", instr_prog[tr.instr_log[:, 1]])
         add("instr_position", instr_pos[tr.instr_log[:, 1]])
         add("instr_offsets", _offsets(tr.instr_log[:, 0], n))
-        log = tr.mem_log
-        t, last = log[:, 0], log[:, 4]
-        age = np.where(last >= 0, t - last, 0 if no_memory else t + 1)
-        add("mem_bank", bank_number[log[:, 1]])
-        add("mem_register", log[:, 2])
-        add("mem_is_write", log[:, 3].astype(bool))
-        add("mem_age", age.astype(np.int64))
-        add("mem_from_reset", last < 0)
-        add("mem_offsets", _offsets(t, n))
+        for key, value in _memory_accesses(tr.mem_log, bank_number, no_memory, n).items():
+            add(key, value)
     data: dict[str, np.ndarray] = {
         "schema_version": np.array(SCHEMA_VERSION),
         "task": np.array(header["task"]),

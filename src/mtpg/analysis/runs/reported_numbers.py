@@ -21,22 +21,26 @@ For each run:
   *training* score (ties, e.g. a task no run has learnt, broken by the highest mean), so no
   test result decides which run is shown as best.
 
-Every figure prints these choices (champion, generation, episodes, denominator).
+Every figure prints these choices (champion, generation, episodes, denominator). Which
+graph file is a run's champion, and its training and single-task scores, come from
+:mod:`mtpg.analysis.runs.champions`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.runs import RunData, normalise_scores, reference_best
-from mtpg.envs.protocol import describe_held_out, training_seeds
-from mtpg.io.rundir import TESTS_DIR, champion_filename
+from mtpg.analysis.runs.champions import (
+    CHAMPION_RULE,
+    champion_path,
+    single_task_scores,
+    training_scores,
+)
+from mtpg.analysis.runs.loading import RunData, normalise_scores, reference_best
+from mtpg.envs.protocol import describe_held_out
 
-#: How the champions are chosen, in words (printed on figures and pages).
-CHAMPION_RULE = "champion = best root by training score at the final generation"
 #: How the best run is chosen, in words.
 BEST_RUN_RULE = (
     "Best run = highest minimum (over tasks) reference-normalised training score of its "
@@ -89,39 +93,12 @@ class RunNumbers:
         return float(min(values)), float(np.mean(values))
 
 
-def champion_path(run: RunData, subset: tuple[str, ...] | None = None) -> Path:
-    """Graph file of a subset's champion (default: all tasks) at the run's final test point."""
-    names = run.tasks if subset is None else subset
-    folder = run.path / TESTS_DIR / f"gen-{run.final_generation:06d}"
-    return folder / champion_filename(tuple(names))
-
-
-def training_scores(run: RunData, path: Path) -> dict[str, float]:
-    """Mean training return per task of a graph file, replayed on the run's training episodes.
-
-    Deterministic, so equal to the score selection used; recomputed rather than read so
-    that it does not depend on what a graph file's metadata holds.
-    """
-    from mtpg.engine.batch import Episodes, evaluate_roots
-    from mtpg.engine.compile import compile_population
-    from mtpg.envs.variants import resolve
-    from mtpg.io.serialize import load_graph
-
-    pop, root, _ = load_graph(path)
-    ev = run.config.evaluation
-    ids = [resolve(t) for t in run.tasks]
-    table = Episodes.grid(ids, training_seeds(ev.train_episodes))
-    returns, _ = evaluate_roots(compile_population(pop), [root], table, 1, ev.no_memory)
-    means = np.asarray(returns).reshape(len(ids), ev.train_episodes).mean(axis=1)
-    return {t: float(m) for t, m in zip(run.tasks, means, strict=True)}
-
-
 def run_numbers(run: RunData) -> RunNumbers:
     """Computes the reported numbers of a run (see the module docstring)."""
     gen = run.final_generation
     row = run.row(run.full_set, gen)
     test = {t: float(row[f"test_{t}"]) for t in run.tasks}
-    single = {t: float(run.row(t, gen)[f"test_{t}"]) for t in run.tasks}
+    single = single_task_scores(run, run.tasks)
     path = champion_path(run)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: the champion graph of the final test point is missing")

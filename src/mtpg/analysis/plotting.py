@@ -1,0 +1,41 @@
+"""Shared matplotlib helpers of every figure: the file-only backend, captions and saving."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+#: Resolution of every PNG figure.
+DPI = 110
+
+
+def pyplot():
+    """The pyplot module of matplotlib on the file-only Agg backend."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, path: Path) -> Path:
+    """Saves a figure as PNG and closes it."""
+    fig.savefig(path, dpi=DPI)
+    pyplot().close(fig)
+    return Path(path)
+
+
+def finish(fig, path: Path, caption: str, legend_rows: int = 0) -> Path:
+    """Adds the caption (what is shown, how chosen) under the axes and saves the figure."""
+    text = "\n".join(
+        textwrap.wrap(caption, width=int(fig.get_figwidth() * 15), break_on_hyphens=False)
+    )
+    lines = text.count("\n") + 1
+    caption_top = (0.16 * lines + 0.1) / fig.get_figheight()
+    for legend in fig.legends:  # a figure legend sits between the plots and the caption
+        legend.set_bbox_to_anchor((0.5, caption_top), transform=fig.transFigure)
+    bottom = caption_top + 0.3 * legend_rows / fig.get_figheight()
+    fig.text(0.01, 0.01, text, fontsize=7, va="bottom", ha="left", color="0.25")
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    return save(fig, path)

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
+from mtpg._faults import check_stop_at
 from mtpg.config import ConfigError, RunConfig, to_toml
 from mtpg.engine.evaluator import BackendLost
 from mtpg.evolve.persist import (
@@ -143,6 +144,7 @@ class Session:
         else:
             check_new_run_dir(path)
         check_training_fits(config)
+        check_stop_at()  # a bad MTPG_TEST_STOP_AT (fault-injection points) is refused here
         ckpt = latest_checkpoint(path) if resume else None
         state = load_state(path, config, ckpt) if ckpt else None
         # -- first write --------------------------------------------------------------

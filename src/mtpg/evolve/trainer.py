@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mtpg._faults import point
 from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
@@ -22,7 +23,6 @@ from mtpg.evolve.selection import candidates, rankings, select, task_subsets
 from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
-from mtpg.testhook import point
 
 #: Metrics columns that measure time and so differ between otherwise identical runs.
 TIMING_COLUMNS = (

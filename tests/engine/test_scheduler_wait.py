@@ -1,5 +1,6 @@
 """The wait for a Dask scheduler is short by default and can be set (within a KillWait)."""
 
+import logging
 import socket
 import time
 
@@ -33,15 +34,33 @@ def test_a_bad_wait_is_refused_naming_the_variable(monkeypatch, text):
 def test_scheduler_wait_option_bounds_the_wait_for_a_missing_scheduler(tmp_path, capsys):
     address = f"tcp://127.0.0.1:{free_port()}"  # nothing listens there
     args = ["train", *tiny_args(), "--generations", "1", "--backend", "dask"]
+    levels = {name: logging.getLogger(name).level for name in ("distributed", "distributed.comm")}
     start = time.monotonic()
     code = main(
         [*args, "--address", address, "--scheduler-wait", "1", "--out", str(tmp_path / "r")]
     )
     took = time.monotonic() - start
     assert code == 2
-    assert f"cannot reach the dask scheduler at {address}" in capsys.readouterr().err
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(
+        f"mtpg train: error: address: cannot reach the dask scheduler at {address}"
+    )
     assert took < 9  # the default wait (10 s) was not used
     assert dask_backend.SCHEDULER_WAIT_ENV not in __import__("os").environ  # put back
+    assert not (tmp_path / "r").exists()  # connected before the run directory was made
+    assert {name: logging.getLogger(name).level for name in levels} == levels  # put back
+
+
+def test_resuming_with_a_missing_scheduler_changes_nothing(tmp_path, capsys):
+    run = tmp_path / "r"
+    assert main(["train", *tiny_args(), "--generations", "1", "--out", str(run)]) == 0
+    before = {p: p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()}
+    address = f"tcp://127.0.0.1:{free_port()}"
+    resume = ["train", "--resume", str(run), "--generations", "2", "--quiet"]
+    code = main([*resume, "--backend", "dask", "--address", address, "--scheduler-wait", "1"])
+    assert code == 2
+    assert "cannot reach the dask scheduler" in capsys.readouterr().err
+    assert {p: p.read_bytes() for p in sorted(run.rglob("*")) if p.is_file()} == before
 
 
 def test_scheduler_wait_option_is_checked(tmp_path, capsys):

@@ -29,10 +29,9 @@ import warnings
 
 import numpy as np
 
-from mtpg.config import ConfigError
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
-from mtpg.engine.evaluator import BackendLost
+from mtpg.engine.evaluator import BackendError, BackendLost
 from mtpg.engine.kernels import run_jobs_queue
 
 #: Batches per worker thread: enough to balance roots of uneven cost, few enough that the
@@ -60,7 +59,7 @@ def scheduler_wait() -> float:
     """Seconds to wait for the scheduler: ``MTPG_SCHEDULER_WAIT`` or :data:`CONNECT_TIMEOUT`.
 
     Raises:
-        ConfigError: The variable is not a number of seconds in (0, 3600].
+        BackendError: The variable is not a number of seconds in (0, 3600].
     """
     text = os.environ.get(SCHEDULER_WAIT_ENV, "").strip()
     if not text:
@@ -70,7 +69,7 @@ def scheduler_wait() -> float:
     except ValueError:
         value = float("nan")
     if not 0 < value <= 3600:
-        raise ConfigError(
+        raise BackendError(
             f"{SCHEDULER_WAIT_ENV} (--scheduler-wait) must be seconds in (0, 3600], got {text!r}"
         )
     return value
@@ -151,6 +150,13 @@ def plan_batches(n_roots: int, threads: int, min_roots: int) -> int:
 class DaskEvaluator:
     """Evaluates batches of roots on a Dask cluster.
 
+    Dask's own log messages in this process (the client's and, for a local cluster, the
+    scheduler's and nannies') are silenced until :meth:`close`: a lost scheduler would
+    otherwise print Dask's tracebacks of every reconnection attempt, while the run reports
+    what matters in one line of its own (errors are one line unless asked for). With the
+    environment variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as
+    Dask logs them.
+
     Args:
         address: Scheduler address (``tcp://HOST:PORT``) of a running cluster, or None to
             start a local cluster on the loopback interface.
@@ -162,12 +168,9 @@ class DaskEvaluator:
         timeout: Seconds to wait for the scheduler (to connect, and to reconnect before it
             counts as lost); :func:`scheduler_wait` when None.
 
-    Dask's own log messages in this process (the client's and, for a local cluster, the
-    scheduler's and nannies') are silenced until :meth:`close`: a lost scheduler would
-    otherwise print Dask's tracebacks of every reconnection attempt, while the run reports
-    what matters in one line of its own (errors are one line unless asked for). With the
-    environment variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as
-    Dask logs them.
+    Raises:
+        BackendError: The scheduler at ``address`` cannot be reached within ``timeout``
+            (Dask's log levels are then put back), or the workers cannot import mtpg.
     """
 
     def __init__(
@@ -194,7 +197,8 @@ class DaskEvaluator:
             try:
                 self.client = Client(address, timeout=timeout)
             except OSError as exc:
-                raise ConfigError(
+                _restore_log_levels(self._log_levels)
+                raise BackendError(
                     f"address: cannot reach the dask scheduler at {address}: {exc}"
                 ) from exc
         else:
@@ -218,7 +222,7 @@ class DaskEvaluator:
             self.pids = self.client.run(warm_up)
         except ImportError as exc:
             self.close()
-            raise ConfigError(
+            raise BackendError(
                 f"address: the workers of {self.address} cannot import mtpg ({exc}); "
                 "install the same mtpg version on every worker"
             ) from exc

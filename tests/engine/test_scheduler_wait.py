@@ -67,3 +67,38 @@ def test_scheduler_wait_option_is_checked(tmp_path, capsys):
     code = main(["train", *tiny_args(), "--scheduler-wait", "0", "--out", str(tmp_path / "r")])
     assert code == 2
     assert "--scheduler-wait must be in (0, 3600]" in capsys.readouterr().err
+
+
+def test_a_refused_evaluator_leaves_dasks_log_levels_as_they_were():
+    levels = {name: logging.getLogger(name).level for name in ("distributed", "distributed.comm")}
+    with pytest.raises(ValueError, match="dask workers must be >= 1, got 0"):
+        dask_backend.DaskEvaluator(n_workers=0)
+    address = f"tcp://127.0.0.1:{free_port()}"
+    with pytest.raises(
+        dask_backend.BackendError, match=f"cannot reach the dask scheduler at {address}"
+    ):
+        dask_backend.DaskEvaluator(address, timeout=0.5)
+    assert {name: logging.getLogger(name).level for name in levels} == levels
+
+
+def test_workers_without_mtpg_are_one_line_and_the_client_is_closed(monkeypatch):
+    closed = []
+
+    class Client:
+        def run(self, fn):
+            raise ImportError("No module named 'mtpg'")
+
+        def close(self):
+            closed.append(True)
+
+    def connect(self, address, *args):
+        self.client, self.address = Client(), address
+
+    monkeypatch.setattr(dask_backend.DaskEvaluator, "_connect", connect)
+    with pytest.raises(dask_backend.BackendError) as err:
+        dask_backend.DaskEvaluator("tcp://10.0.0.1:8786", timeout=1)
+    assert str(err.value) == (
+        "address: the workers of tcp://10.0.0.1:8786 cannot import mtpg (No module named "
+        "'mtpg'); install the same mtpg version on every worker"
+    )
+    assert closed == [True]

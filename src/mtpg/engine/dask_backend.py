@@ -181,9 +181,9 @@ class DaskEvaluator:
         min_roots: int = MIN_ROOTS_PER_BATCH,
         timeout: float | None = None,
     ) -> None:
-        from distributed import Client, LocalCluster
-
         timeout = scheduler_wait() if timeout is None else timeout
+        if not address and n_workers < 1:
+            raise ValueError(f"dask workers must be >= 1, got {n_workers}")
         log_level = logging.INFO if os.environ.get("MTPG_DEBUG") else logging.CRITICAL
         self._log_levels = _set_dask_log_level(log_level)
         self.address = address
@@ -192,40 +192,44 @@ class DaskEvaluator:
         self.lost: str | None = None
         self.resubmits = 0
         self._tables: dict = {}
-        self.cluster = None
-        if address:
-            try:
-                self.client = Client(address, timeout=timeout)
-            except OSError as exc:
-                _restore_log_levels(self._log_levels)
+        self.client = self.cluster = None
+        try:
+            self._connect(address, n_workers, timeout, log_level)
+            self.pids = self.client.run(warm_up)
+        except BaseException as exc:
+            self.close()  # a local cluster started, and Dask's log levels, are put back
+            if isinstance(exc, ImportError):
+                raise BackendError(
+                    f"address: the workers of {self.address} cannot import mtpg ({exc}); "
+                    "install the same mtpg version on every worker"
+                ) from exc
+            if address and self.client is None and isinstance(exc, OSError):
                 raise BackendError(
                     f"address: cannot reach the dask scheduler at {address}: {exc}"
                 ) from exc
-        else:
-            if n_workers < 1:
-                raise ValueError(f"dask workers must be >= 1, got {n_workers}")
-            with warnings.catch_warnings():
-                # with the dashboard off the scheduler still serves health checks over HTTP
-                # on loopback, on port 8787 or, when that is taken, on any free port
-                warnings.filterwarnings("ignore", message="Port .* is already in use")
-                self.cluster = LocalCluster(
-                    n_workers=n_workers,
-                    threads_per_worker=1,
-                    processes=True,
-                    host="127.0.0.1",
-                    dashboard_address=None,
-                    silence_logs=max(log_level, logging.ERROR),
-                )
-            self.client = Client(self.cluster, timeout=timeout)
-            self.address = self.cluster.scheduler_address
-        try:
-            self.pids = self.client.run(warm_up)
-        except ImportError as exc:
-            self.close()
-            raise BackendError(
-                f"address: the workers of {self.address} cannot import mtpg ({exc}); "
-                "install the same mtpg version on every worker"
-            ) from exc
+            raise
+
+    def _connect(self, address: str | None, n_workers: int, timeout: float, log_level: int) -> None:
+        """Connects to the scheduler at ``address``, or starts a local cluster and its client."""
+        from distributed import Client, LocalCluster
+
+        if address:
+            self.client = Client(address, timeout=timeout)
+            return
+        with warnings.catch_warnings():
+            # with the dashboard off the scheduler still serves health checks over HTTP
+            # on loopback, on port 8787 or, when that is taken, on any free port
+            warnings.filterwarnings("ignore", message="Port .* is already in use")
+            self.cluster = LocalCluster(
+                n_workers=n_workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=max(log_level, logging.ERROR),
+            )
+        self.client = Client(self.cluster, timeout=timeout)
+        self.address = self.cluster.scheduler_address
 
     @property
     def threads(self) -> int:

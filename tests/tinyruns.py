@@ -15,7 +15,6 @@ def tiny_args(
         root_size: Initial roots.
         n_elite: Elites (and children) per task subset.
         quiet: Add ``--quiet`` (an ``mtpg train`` option).
-        quiet: Add ``--quiet`` (an ``mtpg train`` option).
         **settings: More ``section__field=value`` settings (``__`` stands for the dot).
 
     Returns:

@@ -249,7 +249,7 @@ class RunConfig:
         _positive(self, "run", ("dask_workers",), minimum=0)
         _check(self.backend in ("local", "dask"), "backend", "must be local or dask", self.backend)
         # whether backend dask has an address or workers is checked when the run starts
-        # (mtpg.engine.evaluator.make_evaluator): overrides arrive one field at a time
+        # (mtpg.evolve.backend.make_evaluator): overrides arrive one field at a time
 
     @property
     def elites_per_subset(self) -> int:

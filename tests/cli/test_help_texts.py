@@ -27,6 +27,17 @@ def test_no_help_text_prints_a_doubled_percent_sign():
     assert "95% stratified" in report
 
 
+@pytest.mark.parametrize("prog", [p.prog for p in every_parser(build_parser())])
+def test_no_help_option_prints_a_doubled_percent_sign(prog, capsys):
+    from mtpg.cli.main import main
+
+    with pytest.raises(SystemExit) as done:
+        main([*prog.split()[1:], "--help"])
+    assert done.value.code == 0
+    text = capsys.readouterr().out
+    assert text.startswith(f"usage: {prog}") and "%%" not in text
+
+
 def test_version_is_the_installed_package_version():
     out = subprocess.run(
         [sys.executable, "-m", "mtpg", "--version"], capture_output=True, text=True, check=True

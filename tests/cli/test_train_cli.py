@@ -172,14 +172,14 @@ def test_a_lost_backend_commits_the_generation_and_resume_finishes_the_run(
     tmp_path, capsys, monkeypatch
 ):
     """A backend lost during generation 2 stops ``mtpg train`` right after it, committed."""
-    import mtpg.evolve.trainer as trainer_module
+    import mtpg.evolve.session as session_module
     from standins import losing_backend
 
     reference = tmp_path / "reference"
     assert main(["train", *TINY, "--generations", "4", "--out", str(reference)]) == 0
     # lost while generation 2 was evaluated
     lost = losing_backend(2, "lost the dask cluster at tcp://127.0.0.1:1 (gone)")
-    monkeypatch.setattr(trainer_module, "make_evaluator", lambda cfg: lost(1))
+    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg: lost(1))
     out = tmp_path / "run"
     capsys.readouterr()
     assert main(["train", *TINY, "--generations", "4", "--out", str(out)]) == 1

@@ -78,6 +78,8 @@ def test_train_stops_when_asked_before_a_generation() -> None:
 
 def test_stop_points_fire_at_the_documented_moments(tmp_path, monkeypatch) -> None:
     """The robustness tests stop runs at these points; each must fire where documented."""
+    import mtpg.io.checkpoint as checkpoint_module
+
     run = tmp_path / "run"
     seen: list[tuple[str, int, bool]] = []
 
@@ -87,6 +89,7 @@ def test_stop_points_fire_at_the_documented_moments(tmp_path, monkeypatch) -> No
 
     monkeypatch.setattr(reporters_module, "point", record)
     monkeypatch.setattr(trainer_module, "point", record)
+    monkeypatch.setattr(checkpoint_module, "point", record)  # passes "checkpoint"
     cfg = tiny("generations=3", "evaluation.test_interval=2", "checkpoint_interval=2")
     Session(run, cfg).run_all()
     phases = [(p, g) for p, g, _ in seen if p != "vary"]

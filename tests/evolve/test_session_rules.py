@@ -127,11 +127,35 @@ def test_a_busy_run_directory_names_itself(two_generations) -> None:
     assert str(err.value).startswith(f"{two_generations}: the run directory is in use by ")
 
 
-def test_a_run_failing_after_the_lock_releases_it(tmp_path) -> None:
+def test_a_backend_refused_at_the_start_leaves_nothing_behind(tmp_path) -> None:
     run = tmp_path / "run"
-    # backend dask without an address or workers is refused when the evaluator starts
+    # backend dask without an address or workers is refused before the first write
     with pytest.raises(ConfigError, match="^backend 'dask' needs either address"):
         Session(run, tiny("backend=dask"))
+    assert not run.exists()
+
+
+def test_a_run_failing_after_the_lock_releases_it_and_closes_its_backend(
+    tmp_path, monkeypatch
+) -> None:
+    import mtpg.evolve.session as session_module
+    from mtpg.engine.evaluator import LocalEvaluator
+
+    closed = []
+
+    class Backend(LocalEvaluator):
+        def close(self) -> None:
+            closed.append(True)
+
+    def failing_trainer(*args) -> None:
+        raise RuntimeError("no trainer")
+
+    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg: Backend(1))
+    monkeypatch.setattr(session_module, "Trainer", failing_trainer)
+    run = tmp_path / "run"
+    with pytest.raises(RuntimeError, match="no trainer"):
+        Session(run, tiny())
+    assert closed == [True]
     lock_dir(run).release()  # free again
 
 
@@ -153,11 +177,11 @@ def test_run_all_asks_should_stop_before_each_generation(tmp_path) -> None:
 
 def test_a_lost_backend_commits_the_generation_it_was_lost_in(tmp_path, monkeypatch):
     """``run_all`` commits the last generation, then raises, even between checkpoints."""
-    import mtpg.evolve.trainer as trainer_module
+    import mtpg.evolve.session as session_module
     from mtpg.engine.evaluator import BackendLost
     from standins import losing_backend
 
-    monkeypatch.setattr(trainer_module, "make_evaluator", lambda cfg: losing_backend(2)(1))
+    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg: losing_backend(2)(1))
     run = tmp_path / "run"
     session = Session(run, tiny("checkpoint_interval=10", "generations=4"))
     with pytest.raises(BackendLost, match="gone"):

@@ -116,14 +116,19 @@ def test_saved_bytes_are_deterministic_and_use_the_stated_compression(tmp_path) 
     assert raw == gzip.compress(gzip.decompress(raw), compresslevel=COMPRESS_LEVEL, mtime=0)
 
 
-def test_save_refuses_a_non_dict_and_calls_the_hook_before_the_rename(tmp_path) -> None:
+def test_save_refuses_a_non_dict_and_passes_its_fault_point_before_the_rename(
+    tmp_path, monkeypatch
+) -> None:
     path = tmp_path / "gen-000002.json.gz"
     with pytest.raises(CheckpointError) as err:
         save_checkpoint(path, [1])
     assert str(err.value) == f"{path}: payload must be a dict, got list"
     seen = []
-    save_checkpoint(path, SMALL, lambda: seen.append(path.exists()))
-    assert seen == [False] and load_checkpoint(path) == SMALL
+    monkeypatch.setattr(checkpoint_module, "point", lambda *at: seen.append((*at, path.exists())))
+    save_checkpoint(path, SMALL)
+    assert seen == [("checkpoint", 2, False)] and load_checkpoint(path) == SMALL
+    save_checkpoint(tmp_path / "other.json.gz", SMALL)  # not a generation's name: no point
+    assert len(seen) == 1
 
 
 def test_a_failed_write_keeps_its_error_number(tmp_path, monkeypatch) -> None:

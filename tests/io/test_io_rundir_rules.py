@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 
 import pytest
 
@@ -177,12 +178,19 @@ def test_files_in_checkpoints_that_are_not_checkpoints_do_not_count(tmp_path) ->
         check_new_run_dir(run.path)
 
 
-def test_atomic_writes_go_through_a_temporary_file_beside_the_target(tmp_path) -> None:
+def test_atomic_writes_go_through_a_temporary_file_beside_the_target(tmp_path, monkeypatch) -> None:
     from mtpg.io.checkpoint import save_checkpoint
 
     path = tmp_path / "gen-000001.json.gz"
     seen = []
-    save_checkpoint(path, {"a": 1}, lambda: seen.append(sorted(p.name for p in tmp_path.iterdir())))
+    real = os.replace
+
+    def replace(src, dst):
+        seen.append(sorted(p.name for p in tmp_path.iterdir()))
+        real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    save_checkpoint(path, {"a": 1})
     (names,) = seen
     assert len(names) == 1 and is_temp_file(names[0])
     assert names[0].startswith(".gen-000001.json.gz.")

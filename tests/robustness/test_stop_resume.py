@@ -1,6 +1,6 @@
 """A run stopped at any moment, by any signal, resumes into exactly the uninterrupted run.
 
-Moments are hit precisely with the MTPG_TEST_STOP_AT hook (``mtpg.testhook``): the
+Moments are hit precisely with the fault-injection points (``mtpg._faults``): the
 process signals itself there. The slow set covers 23 moments per signal plus timed kills.
 """
 
@@ -45,6 +45,12 @@ MOMENTS = [
     "commit:7",
     "checkpoint:7",
 ]
+
+
+def test_the_moments_pass_every_fault_injection_phase():
+    from mtpg._faults import PHASES
+
+    assert {m.split(":")[0] for m in MOMENTS} == set(PHASES)
 
 
 @pytest.fixture(scope="module")

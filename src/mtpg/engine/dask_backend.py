@@ -29,10 +29,9 @@ import warnings
 
 import numpy as np
 
-from mtpg.config import ConfigError
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
-from mtpg.engine.evaluator import BackendLost
+from mtpg.engine.evaluator import BackendError, BackendLost
 from mtpg.engine.kernels import run_jobs_queue
 
 #: Batches per worker thread: enough to balance roots of uneven cost, few enough that the
@@ -60,7 +59,7 @@ def scheduler_wait() -> float:
     """Seconds to wait for the scheduler: ``MTPG_SCHEDULER_WAIT`` or :data:`CONNECT_TIMEOUT`.
 
     Raises:
-        ConfigError: The variable is not a number of seconds in (0, 3600].
+        BackendError: The variable is not a number of seconds in (0, 3600].
     """
     text = os.environ.get(SCHEDULER_WAIT_ENV, "").strip()
     if not text:
@@ -70,7 +69,7 @@ def scheduler_wait() -> float:
     except ValueError:
         value = float("nan")
     if not 0 < value <= 3600:
-        raise ConfigError(
+        raise BackendError(
             f"{SCHEDULER_WAIT_ENV} (--scheduler-wait) must be seconds in (0, 3600], got {text!r}"
         )
     return value
@@ -151,6 +150,13 @@ def plan_batches(n_roots: int, threads: int, min_roots: int) -> int:
 class DaskEvaluator:
     """Evaluates batches of roots on a Dask cluster.
 
+    Dask's own log messages in this process (the client's and, for a local cluster, the
+    scheduler's and nannies') are silenced until :meth:`close`: a lost scheduler would
+    otherwise print Dask's tracebacks of every reconnection attempt, while the run reports
+    what matters in one line of its own (errors are one line unless asked for). With the
+    environment variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as
+    Dask logs them.
+
     Args:
         address: Scheduler address (``tcp://HOST:PORT``) of a running cluster, or None to
             start a local cluster on the loopback interface.
@@ -162,12 +168,9 @@ class DaskEvaluator:
         timeout: Seconds to wait for the scheduler (to connect, and to reconnect before it
             counts as lost); :func:`scheduler_wait` when None.
 
-    Dask's own log messages in this process (the client's and, for a local cluster, the
-    scheduler's and nannies') are silenced until :meth:`close`: a lost scheduler would
-    otherwise print Dask's tracebacks of every reconnection attempt, while the run reports
-    what matters in one line of its own (errors are one line unless asked for). With the
-    environment variable ``MTPG_DEBUG`` set (``mtpg --debug`` sets it) they are shown as
-    Dask logs them.
+    Raises:
+        BackendError: The scheduler at ``address`` cannot be reached within ``timeout``
+            (Dask's log levels are then put back), or the workers cannot import mtpg.
     """
 
     def __init__(
@@ -178,9 +181,9 @@ class DaskEvaluator:
         min_roots: int = MIN_ROOTS_PER_BATCH,
         timeout: float | None = None,
     ) -> None:
-        from distributed import Client, LocalCluster
-
         timeout = scheduler_wait() if timeout is None else timeout
+        if not address and n_workers < 1:
+            raise ValueError(f"dask workers must be >= 1, got {n_workers}")
         log_level = logging.INFO if os.environ.get("MTPG_DEBUG") else logging.CRITICAL
         self._log_levels = _set_dask_log_level(log_level)
         self.address = address
@@ -189,39 +192,44 @@ class DaskEvaluator:
         self.lost: str | None = None
         self.resubmits = 0
         self._tables: dict = {}
-        self.cluster = None
-        if address:
-            try:
-                self.client = Client(address, timeout=timeout)
-            except OSError as exc:
-                raise ConfigError(
+        self.client = self.cluster = None
+        try:
+            self._connect(address, n_workers, timeout, log_level)
+            self.pids = self.client.run(warm_up)
+        except BaseException as exc:
+            self.close()  # a local cluster started, and Dask's log levels, are put back
+            if isinstance(exc, ImportError):
+                raise BackendError(
+                    f"address: the workers of {self.address} cannot import mtpg ({exc}); "
+                    "install the same mtpg version on every worker"
+                ) from exc
+            if address and self.client is None and isinstance(exc, OSError):
+                raise BackendError(
                     f"address: cannot reach the dask scheduler at {address}: {exc}"
                 ) from exc
-        else:
-            if n_workers < 1:
-                raise ValueError(f"dask workers must be >= 1, got {n_workers}")
-            with warnings.catch_warnings():
-                # with the dashboard off the scheduler still serves health checks over HTTP
-                # on loopback, on port 8787 or, when that is taken, on any free port
-                warnings.filterwarnings("ignore", message="Port .* is already in use")
-                self.cluster = LocalCluster(
-                    n_workers=n_workers,
-                    threads_per_worker=1,
-                    processes=True,
-                    host="127.0.0.1",
-                    dashboard_address=None,
-                    silence_logs=max(log_level, logging.ERROR),
-                )
-            self.client = Client(self.cluster, timeout=timeout)
-            self.address = self.cluster.scheduler_address
-        try:
-            self.pids = self.client.run(warm_up)
-        except ImportError as exc:
-            self.close()
-            raise ConfigError(
-                f"address: the workers of {self.address} cannot import mtpg ({exc}); "
-                "install the same mtpg version on every worker"
-            ) from exc
+            raise
+
+    def _connect(self, address: str | None, n_workers: int, timeout: float, log_level: int) -> None:
+        """Connects to the scheduler at ``address``, or starts a local cluster and its client."""
+        from distributed import Client, LocalCluster
+
+        if address:
+            self.client = Client(address, timeout=timeout)
+            return
+        with warnings.catch_warnings():
+            # with the dashboard off the scheduler still serves health checks over HTTP
+            # on loopback, on port 8787 or, when that is taken, on any free port
+            warnings.filterwarnings("ignore", message="Port .* is already in use")
+            self.cluster = LocalCluster(
+                n_workers=n_workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=max(log_level, logging.ERROR),
+            )
+        self.client = Client(self.cluster, timeout=timeout)
+        self.address = self.cluster.scheduler_address
 
     @property
     def threads(self) -> int:

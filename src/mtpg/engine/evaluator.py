@@ -13,6 +13,9 @@ Backends:
 * ``dask`` (:class:`mtpg.engine.dask_backend.DaskEvaluator`): batches of roots on the
   worker processes of a Dask cluster, either an existing one (``address``) or a local one
   started for the run (``dask_workers``). Needs the optional ``dask`` extra.
+
+Which backend a run uses is read from its configuration by
+:func:`mtpg.evolve.backend.make_evaluator`; the engine knows nothing of configurations.
 """
 
 from __future__ import annotations
@@ -21,7 +24,6 @@ from typing import Protocol
 
 import numpy as np
 
-from mtpg.config import ConfigError, RunConfig
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
 
@@ -31,6 +33,13 @@ BACKENDS = ("local", "dask")
 
 class BackendLost(RuntimeError):
     """The evaluation backend went away; the run stops at a generation boundary."""
+
+
+class BackendError(ValueError):
+    """A backend cannot be set up as asked (e.g. its scheduler cannot be reached).
+
+    The message is one line and names the setting at fault (``address: ...``).
+    """
 
 
 class Evaluator(Protocol):
@@ -93,41 +102,3 @@ class LocalEvaluator:
 
     def close(self) -> None:
         """Nothing to release."""
-
-
-def make_evaluator(config: RunConfig) -> Evaluator:
-    """The evaluator a run configuration asks for.
-
-    Args:
-        config: The run configuration (``backend``, ``address``, ``dask_workers``,
-            ``workers``).
-
-    Returns:
-        A :class:`LocalEvaluator` or a connected
-        :class:`~mtpg.engine.dask_backend.DaskEvaluator`.
-
-    Raises:
-        ConfigError: The dask backend is requested but its packages are not installed.
-    """
-    if config.backend == "local":
-        return LocalEvaluator(config.workers)
-    if bool(config.address) == (config.dask_workers > 0):
-        raise ConfigError(
-            "backend 'dask' needs either address (a running cluster's scheduler, "
-            f"tcp://HOST:PORT) or dask_workers >= 1 (a local cluster), got address "
-            f"{config.address!r} and dask_workers {config.dask_workers}"
-        )
-    try:
-        import distributed  # noqa: F401
-    except ImportError as exc:
-        raise ConfigError(
-            "backend 'dask' needs the packages dask and distributed, which are not "
-            "installed; install them with: pip install 'mtpg[dask]'"
-        ) from exc
-    from mtpg.engine.dask_backend import DaskEvaluator
-
-    return DaskEvaluator(
-        address=config.address or None,
-        n_workers=config.dask_workers,
-        fallback_threads=config.workers,
-    )

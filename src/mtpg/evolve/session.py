@@ -22,8 +22,10 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
+from mtpg._faults import check_stop_at
 from mtpg.config import ConfigError, RunConfig, to_toml
 from mtpg.engine.evaluator import BackendLost
+from mtpg.evolve.backend import make_evaluator
 from mtpg.evolve.persist import (
     RESUMABLE_CHANGES,
     config_differences,
@@ -143,24 +145,28 @@ class Session:
         else:
             check_new_run_dir(path)
         check_training_fits(config)
+        check_stop_at()  # a bad MTPG_TEST_STOP_AT (fault-injection points) is refused here
         ckpt = latest_checkpoint(path) if resume else None
         state = load_state(path, config, ckpt) if ckpt else None
+        evaluator = make_evaluator(config)  # an unreachable scheduler stops the run here
         # -- first write --------------------------------------------------------------
-        path.mkdir(parents=True, exist_ok=True)
-        self.lock: DirLock | None = lock_dir(path, "the run directory")
+        self.lock: DirLock | None = None
         self.metrics: MetricsReporter | None = None
         self.tests: TestsReporter | None = None
         try:
+            path.mkdir(parents=True, exist_ok=True)
+            self.lock = lock_dir(path, "the run directory")
             if resume and latest_checkpoint(path) != ckpt:  # committed before our lock
                 ckpt = latest_checkpoint(path)
                 state = load_state(path, config, ckpt) if ckpt else None
             self.lock.claim()
             self.run = init_run_dir(path, to_toml(config), resume=resume)
             self.config = config
-            self.trainer = Trainer(config, state)
+            self.trainer = Trainer(config, state, evaluator)
             self._roll_back()
         except BaseException:
             self.close()
+            evaluator.close()  # e.g. stops a local Dask cluster started for the run
             raise
         self.checkpoints = CheckpointReporter(
             self.run.path, config.checkpoint_interval, self.trainer.state.generation

@@ -11,19 +11,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mtpg._faults import point
 from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
-from mtpg.engine.evaluator import make_evaluator
+from mtpg.engine.evaluator import Evaluator
 from mtpg.envs.protocol import resampled_training_seeds, validation_seeds
 from mtpg.envs.variants import spec_of
+from mtpg.evolve.backend import make_evaluator
 from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
 from mtpg.evolve.testing import play_test
 from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
-from mtpg.testhook import point
 
 #: Metrics columns that measure time and so differ between otherwise identical runs.
 TIMING_COLUMNS = (
@@ -123,9 +124,16 @@ class Trainer:
     Args:
         config: The run configuration.
         state: A state to continue from (a fresh run when None).
+        evaluator: The evaluation backend (:func:`~mtpg.evolve.backend.make_evaluator`
+            of ``config`` when None); the trainer closes it.
     """
 
-    def __init__(self, config: RunConfig, state: TrainerState | None = None) -> None:
+    def __init__(
+        self,
+        config: RunConfig,
+        state: TrainerState | None = None,
+        evaluator: Evaluator | None = None,
+    ) -> None:
         self.config = config
         self.state = state or TrainerState.new(config)
         ev = config.evaluation
@@ -138,7 +146,7 @@ class Trainer:
             if ev.validation_episodes > 0
             else None
         )
-        self.evaluator = make_evaluator(config)
+        self.evaluator = evaluator if evaluator is not None else make_evaluator(config)
 
     def training_block(self, gen: int) -> int:
         """The training block of generation ``gen``: 0 unless resampling is on.

@@ -50,7 +50,8 @@ def atomic_write_bytes(
         path: Destination file; its directory must exist.
         data: The complete new contents.
         before_replace: Called after the data is flushed to the temporary file and before
-            the rename (a test hook: a stop there leaves only the temporary file).
+            the rename (the checkpoint's fault-injection point: a stop there leaves only the
+            temporary file).
 
     Raises:
         OSError: When writing or renaming fails.

@@ -20,10 +20,10 @@ import json
 import os
 import re
 import zlib
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from mtpg._faults import point
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
 from mtpg.io._bounded import (
     MAX_CHECKPOINT_BYTES,
@@ -96,18 +96,16 @@ def payload_digest(payload: Any) -> str:
     return hashlib.sha256(canonical_json(payload)).hexdigest()
 
 
-def save_checkpoint(
-    path: str | os.PathLike[str],
-    payload: dict[str, Any],
-    before_replace: Callable[[], None] | None = None,
-) -> None:
+def save_checkpoint(path: str | os.PathLike[str], payload: dict[str, Any]) -> None:
     """Writes a checkpoint atomically (temp file, fsync, rename, directory fsync).
+
+    Once the data is in the temporary file, just before it is renamed into place, the
+    fault-injection point ``checkpoint`` of the generation the file's name states is
+    passed (:mod:`mtpg._faults`; none for a file not named ``gen-NNNNNN.json.gz``).
 
     Args:
         path: Destination file; its directory must exist.
         payload: JSON-native run state.
-        before_replace: Called once the data is in the temporary file, just before it is
-            renamed into place (a test hook).
 
     Raises:
         CheckpointError: When the payload is not JSON-native.
@@ -136,6 +134,8 @@ def save_checkpoint(
         )
     )
     data = gzip.compress(doc, compresslevel=COMPRESS_LEVEL, mtime=0)
+    gen = checkpoint_generation(path)
+    before_replace = None if gen is None else lambda: point("checkpoint", gen)
     try:
         atomic_write_bytes(path, data, before_replace)
     except OSError as exc:

@@ -22,13 +22,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from mtpg._faults import point
 from mtpg.envs.core import TASK_NAMES
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
 from mtpg.io.checkpoint import CHECKPOINT_DIR
 from mtpg.io.lock import LOCK_FILE
 from mtpg.io.serialize import load_graph, save_graph
 from mtpg.model.graph import Population
-from mtpg.testhook import point
 
 CONFIG_FILE = "config.toml"
 METRICS_FILE = "metrics.csv"

@@ -5,7 +5,8 @@ import sys
 import pytest
 
 from mtpg.config import ConfigError, build_config
-from mtpg.engine.evaluator import LocalEvaluator, make_evaluator
+from mtpg.engine.evaluator import LocalEvaluator
+from mtpg.evolve.backend import make_evaluator
 
 
 def config(*overrides):

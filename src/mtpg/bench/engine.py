@@ -400,7 +400,7 @@ def benchmark(
         "episodes": episodes,
         "decisions": decisions,
         "pointer_fraction": work.pointer_fraction,
-        "effective_instruction_fraction": len(work.cp.instrs) / total_instr,
+        "effective_instruction_fraction": len(work.cp.graph.instrs) / total_instr,
         "repeats": repeats,
         "seconds": seconds,
         "seconds_all": [r.seconds for r in runs],

@@ -15,8 +15,8 @@ import pytest
 from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.kernels import run_jobs_queue
-from mtpg.engine.record import record
-from mtpg.engine.trace import trace_episode, trace_episode_kernel
+from mtpg.engine.record import new_recorder
+from mtpg.engine.trace import trace_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe, env_reset, env_step
 from mtpg.envs.core import N_TASKS, STATE_SIZE, STEP_SLOT
@@ -116,11 +116,9 @@ def test_an_id_without_a_branch_is_loud(graph):
         params,
     )  # fmt: skip
     jobs = Jobs(np.array([cp.team_index(root)]), np.zeros(1, np.int64))
-    rec, n = record(
-        lambda rec: trace_episode_kernel(cp.graph, jobs, table, False, rec),
-        cp.graph, cp.team_index(root), 200, False,
-    )  # fmt: skip
-    assert np.isnan(rec.observations[:n]).all() and n == 1 and np.isnan(rec.rewards[:n]).all()
     out = BatchResult.zeros(1)
     run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, False, out, cp.graph)
     assert np.isnan(out.returns[0]) and out.steps[0] == 1
+    rec = new_recorder(cp.graph, np.full(4, 1000), 200, False)  # traced: the same loop
+    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, False, out, cp.graph, rec)
+    assert np.isnan(rec.observations[0]).all() and np.isnan(rec.rewards[0])

@@ -46,6 +46,17 @@ class Episodes(NamedTuple):
         )
 
     @classmethod
+    def single(cls, task: int, start: np.ndarray, noise: np.ndarray) -> Episodes:
+        """A table of one given episode: ``task`` from ``start`` with the ``noise`` row."""
+        return cls(
+            np.array([task], dtype=np.int64),
+            np.zeros(1, dtype=np.int64),
+            np.ascontiguousarray(start, dtype=np.float64).reshape(1, -1),
+            np.ascontiguousarray(noise, dtype=np.float64).reshape(1, -1),
+            task_params(),
+        )
+
+    @classmethod
     def grid(cls, tasks: list[int], seeds: list[int] | np.ndarray) -> Episodes:
         """Every task with every seed, task-major: episode ``i * len(seeds) + k``."""
         seeds = np.asarray(seeds, dtype=np.int64)

@@ -6,9 +6,9 @@ compiled graph (:class:`~mtpg.engine.compile.Graph`), the jobs and the episode t
 (:class:`~mtpg.engine.batch.BatchResult`) and one thread's private :class:`Buffers`, whose
 float64 workspace ``W`` is laid out as documented in :mod:`mtpg.engine.compile`.
 
-The decision semantics live in :func:`decide` alone and one episode in
-:func:`play_episode` alone: the tracer (:mod:`mtpg.engine.trace`) runs the same two with a
-:class:`~mtpg.engine.record.Recorder`, and the training path passes ``rec=None``, with
+The decision semantics live in :func:`decide` alone and the episode loop in
+:func:`run_jobs_queue` alone: the tracer (:mod:`mtpg.engine.trace`) runs the same two with
+a :class:`~mtpg.engine.record.Recorder`, and the training path passes ``rec=None``, with
 which Numba compiles every recording branch out.
 
 Memory banks are reset lazily: ``bank_stamp[b]`` records the episode in which bank ``b``
@@ -134,7 +134,9 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
     Returns:
         ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
     """
-    team_offsets, team_members, prog_offsets, instrs, prog_action, prog_bank, R, M, base = g
+    team_offsets, team_members, prog_offsets = g.team_offsets, g.team_members, g.prog_offsets
+    instrs, prog_action, prog_bank = g.instrs, g.prog_action, g.prog_bank
+    R, M, base = g.n_registers, g.n_memory, g.mem_base
     W, team_stamp, bank_stamp, counts = buf.W, buf.team_stamp, buf.bank_stamp, buf.counts
     # Every index below is unsigned (np.uint64): Numba then emits plain loads and stores,
     # without the fix-up for negative (from-the-end) indices that a signed index costs at
@@ -195,65 +197,12 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
         team = np.uint64(act)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def play_episode(g, buf, jobs, table, j, stamp, no_memory, rec):
-    """Plays job ``j``: one episode of ``table`` with one root, from a fresh memory state.
-
-    The package's one compiled episode loop: the batch kernels run it with ``rec=None``,
-    the tracer with a recorder. The episode's mark is ``j`` (its lazy bank reset), so
-    results do not depend on which worker plays the job or what it played before.
-
-    Args:
-        g: The compiled graph.
-        buf: The thread's :class:`Buffers`.
-        jobs: :class:`~mtpg.engine.batch.Jobs`: job ``j`` plays episode row
-            ``jobs.episodes[j]`` with root ``jobs.roots[j]``.
-        table: :class:`~mtpg.engine.batch.Episodes`: task, start state and noise row of
-            each episode, and the parameter table the task ids index.
-        j: The job.
-        stamp: The first decision's mark (decisions are marked ``stamp, stamp + 1, ...``).
-        no_memory: The no-memory ablation.
-        rec: ``None``, or the recorder.
-
-    Returns:
-        ``(return, steps, next stamp)``.
-    """
-    e = jobs.episodes[j]
-    root = jobs.roots[j]
-    state, obs, counts = buf.state, buf.obs, buf.counts
-    task = table.tasks[e]
-    p = table.params[task]  # the parameter row, taken once per episode
-    kind = np.int64(p[P_KIND])  # the kernels playing it (the base task of a variant)
-    okind = observe_kind(p)  # and observing it
-    env_reset(task, table.params, table.starts[e], state)
-    env_observe_row(okind, p, state, table.noise[e, 0], obs)
-    counts[:] = 0
-    total = 0.0
-    t = 0
-    if rec is not None:
-        record_state(rec, 0, 0.0, state)
-    while True:
-        if rec is not None:
-            record_observation(rec, t, obs)
-        a_d, a_c = decide(g, buf, root, stamp, j, no_memory, rec)
-        stamp += 1
-        if rec is not None:
-            record_decision(rec, t, a_d, a_c, buf.W, buf.bank_stamp, j, g.mem_base, g.n_memory)
-        # The one task dispatch, inlined (no call passing the arrays per step).
-        reward, terminated, truncated = task_step(kind, p, state, a_d, a_c)
-        total += reward
-        t += 1
-        if rec is not None:
-            record_state(rec, t, reward, state)
-        if terminated or truncated:
-            break
-        env_observe_row(okind, p, state, table.noise[e, t], obs)
-    return total, t, stamp
-
-
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g):
+def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
     """One worker: takes blocks of jobs from a shared queue and plays them serially.
+
+    Holds the package's one compiled episode loop: the batch kernels run it with
+    ``rec=None`` (Numba compiles the recording out), the tracer with a recorder.
 
     Jobs go in blocks of ``block`` consecutive jobs; block ``b`` is jobs
     ``b * block ... (b + 1) * block - 1``. The queue is the int64 counter ``next_block[0]``:
@@ -269,12 +218,21 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g):
 
     Releases the GIL, so several Python threads (e.g. of one Dask worker) run it at once.
 
-    Job ``j`` (of :class:`~mtpg.engine.batch.Jobs` ``jobs``) plays its episode of ``table``
-    (:class:`~mtpg.engine.batch.Episodes`) with its root on graph ``g`` and writes its
-    return, steps, teams visited and instructions executed to ``out``
-    (:class:`~mtpg.engine.batch.BatchResult`) at ``j``.
+    Args:
+        next_block: int64 ``[1]``: the queue's counter.
+        block: Jobs per block.
+        jobs: :class:`~mtpg.engine.batch.Jobs`: job ``j`` plays episode row
+            ``jobs.episodes[j]`` with root ``jobs.roots[j]``.
+        table: :class:`~mtpg.engine.batch.Episodes`: task, start state and noise row of
+            each episode, and the parameter table the task ids index.
+        no_memory: The no-memory ablation.
+        out: :class:`~mtpg.engine.batch.BatchResult`: job ``j``'s return, steps, teams
+            visited and instructions executed are written at ``j``.
+        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
+        rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` of a one-job run.
     """
     buf = thread_buffers(g)
+    W, obs, state, counts = buf.W, buf.obs, buf.state, buf.counts
     stamp = 0
     n_jobs = len(jobs.roots)
     while True:
@@ -282,11 +240,39 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g):
         if first >= n_jobs:
             break
         for j in range(first, min(first + block, n_jobs)):
-            total, t, stamp = play_episode(g, buf, jobs, table, j, stamp, no_memory, None)
+            e = jobs.episodes[j]
+            root = jobs.roots[j]
+            task = table.tasks[e]
+            p = table.params[task]  # the parameter row, taken once per episode
+            kind = np.int64(p[P_KIND])  # the kernels playing it (the base task of a variant)
+            okind = observe_kind(p)  # and observing it
+            env_reset(task, table.params, table.starts[e], state)
+            env_observe_row(okind, p, state, table.noise[e, 0], obs)
+            counts[:] = 0
+            total = 0.0
+            t = 0
+            if rec is not None:
+                record_state(rec, 0, 0.0, state)
+            while True:
+                if rec is not None:
+                    record_observation(rec, t, obs)
+                a_d, a_c = decide(g, buf, root, stamp, j, no_memory, rec)
+                stamp += 1
+                if rec is not None:
+                    record_decision(rec, t, a_d, a_c, W, buf.bank_stamp, j, g.mem_base, g.n_memory)
+                # The one task dispatch, inlined (no call passing the arrays per step).
+                reward, terminated, truncated = task_step(kind, p, state, a_d, a_c)
+                total += reward
+                t += 1
+                if rec is not None:
+                    record_state(rec, t, reward, state)
+                if terminated or truncated:
+                    break
+                env_observe_row(okind, p, state, table.noise[e, t], obs)
             out.returns[j] = total
             out.steps[j] = t
-            out.teams[j] = buf.counts[0]
-            out.instructions[j] = buf.counts[1]
+            out.teams[j] = counts[0]
+            out.instructions[j] = counts[1]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

@@ -1,7 +1,7 @@
 """Traced execution: what every decision did, for the tests and the analyses of section 6.
 
 The production :func:`~mtpg.engine.kernels.decide` and
-:func:`~mtpg.engine.kernels.play_episode` with a :class:`~mtpg.engine.record.Recorder`
+:func:`~mtpg.engine.kernels.run_jobs_queue` with a :class:`~mtpg.engine.record.Recorder`
 (the training path passes none, and Numba compiles the recording out of it): one compiled
 copy of the decision semantics. Per decision it records the teams visited, every program
 executed with its bid, every instruction executed, and every memory register read or
@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from mtpg.engine.batch import Episodes, Jobs
+from mtpg.engine.batch import BatchResult, Episodes, Jobs
 from mtpg.engine.compile import CompiledPopulation
-from mtpg.engine.kernels import decide, play_episode, thread_buffers
+from mtpg.engine.kernels import decide, run_jobs_queue, thread_buffers
 from mtpg.engine.record import (
     INSTRUCTIONS,
     MEMORY,
@@ -29,15 +29,6 @@ from mtpg.engine.record import (
     record_decision,
     record_observation,
 )
-from mtpg.envs.variants import task_params
-
-
-@njit(cache=True, error_model="numpy")
-def trace_episode_kernel(g, jobs, table, no_memory, rec):
-    """Plays job 0 of ``jobs`` as the batch kernels do, recording into ``rec``; its steps."""
-    buf = thread_buffers(g)
-    _, t, _ = play_episode(g, buf, jobs, table, 0, 0, no_memory, rec)
-    return t
 
 
 @njit(cache=True, error_model="numpy")
@@ -161,20 +152,19 @@ def trace_episode(
 ) -> Trace:
     """Traces one episode of ``task`` from ``start`` with the episode's ``noise`` row."""
     root = cp.team_index(root_id)
-    noise = np.ascontiguousarray(noise, dtype=np.float64).reshape(1, -1)
-    table = Episodes(
-        np.array([task], dtype=np.int64),
-        np.zeros(1, dtype=np.int64),
-        np.ascontiguousarray(start, dtype=np.float64).reshape(1, -1),
-        noise,
-        task_params(),
-    )
+    table = Episodes.single(task, start, noise)
     jobs = Jobs(np.array([root], dtype=np.int64), np.zeros(1, dtype=np.int64))
+    out = BatchResult.zeros(1)
+
+    def run(rec: Recorder) -> int:
+        run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, no_memory, out, cp.graph, rec)
+        return int(out.steps[0])
+
     rec, steps = record(
-        lambda rec: trace_episode_kernel(cp.graph, jobs, table, no_memory, rec),
+        run,
         cp.graph,
         root,
-        noise.shape[1] - 1,
+        table.noise.shape[1] - 1,
         snapshot,
     )
     return _trace(rec, steps)

@@ -232,7 +232,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
         rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` of a one-job run.
     """
     buf = thread_buffers(g)
-    W, obs, state, counts = buf.W, buf.obs, buf.state, buf.counts
+    obs, state, counts = buf.obs, buf.state, buf.counts
     stamp = 0
     n_jobs = len(jobs.roots)
     while True:
@@ -259,7 +259,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
                 a_d, a_c = decide(g, buf, root, stamp, j, no_memory, rec)
                 stamp += 1
                 if rec is not None:
-                    record_decision(rec, t, a_d, a_c, W, buf.bank_stamp, j, g.mem_base, g.n_memory)
+                    record_decision(rec, t, a_d, a_c, buf, g, j)
                 # The one task dispatch, inlined (no call passing the arrays per step).
                 reward, terminated, truncated = task_step(kind, p, state, a_d, a_c)
                 total += reward

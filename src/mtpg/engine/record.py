@@ -213,18 +213,19 @@ def record_program(rec: Recorder, p, bid) -> None:
 
 
 @njit(cache=True)
-def record_decision(rec: Recorder, t, a_d, a_c, W, bank_stamp, episode, base, M) -> None:
+def record_decision(rec: Recorder, t, a_d, a_c, buf, g, episode) -> None:
     """Decision ``t``'s action and, if snapshotted, every bank as a program sees it.
 
-    A bank not yet reset in this episode (stale mark) reads zero, whatever the workspace
-    still holds from an earlier episode.
+    A bank not yet reset in episode ``episode`` (stale mark in ``buf.bank_stamp``) reads
+    zero, whatever the workspace still holds from an earlier episode.
     """
     if t < rec.actions.shape[0]:
         rec.actions[t, 0] = a_d
         rec.actions[t, 1] = a_c
     if t < rec.memory.shape[0]:
-        for b in range(len(bank_stamp)):
-            live = bank_stamp[b] == episode
+        W, M, base = buf.W, g.n_memory, g.mem_base
+        for b in range(len(buf.bank_stamp)):
+            live = buf.bank_stamp[b] == episode
             for j in range(M):
                 rec.memory[t, b * M + j] = W[base + b * M + j] if live else 0.0
 

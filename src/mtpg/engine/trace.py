@@ -48,7 +48,7 @@ def trace_sequence_kernel(g, root, obs_seq, marks, no_memory, rec):
         buf.obs[1] = obs_seq[t, 1]
         record_observation(rec, t, buf.obs)
         a_d, a_c = decide(g, buf, root, t, marks[t], no_memory, rec)
-        record_decision(rec, t, a_d, a_c, buf.W, buf.bank_stamp, marks[t], g.mem_base, g.n_memory)
+        record_decision(rec, t, a_d, a_c, buf, g, marks[t])
     return len(obs_seq)
 
 

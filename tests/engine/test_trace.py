@@ -84,3 +84,14 @@ def test_a_run_whose_logs_overflow_is_played_again_with_room_for_all(monkeypatch
     assert len(played) == 2
     for field in roomy.__dataclass_fields__:
         assert np.array_equal(getattr(roomy, field), getattr(tight, field)), field
+
+
+def test_a_traced_episode_ends_where_its_noise_row_ends():
+    from mtpg.engine.workload import layered_graphs
+    from mtpg.envs.core import ACROBOT
+
+    pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=2, programs=4, instructions=4)
+    cp = compile_population(pop)
+    starts, noise = make_episodes(np.array([ACROBOT]), np.array([0]))  # up to 500 steps
+    trace = trace_episode(cp, roots[0], ACROBOT, starts[0], noise[0, :8])
+    assert len(trace.actions) == 7 and len(trace.states) == 8

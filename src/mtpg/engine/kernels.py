@@ -229,7 +229,9 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
         out: :class:`~mtpg.engine.batch.BatchResult`: job ``j``'s return, steps, teams
             visited and instructions executed are written at ``j``.
         g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
-        rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` of a one-job run.
+        rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` of a one-job run
+            (which also ends where the episode's noise row ends, as a time limit that
+            would read past it cannot occur in a table of ``make_episodes``).
     """
     buf = thread_buffers(g)
     obs, state, counts = buf.obs, buf.state, buf.counts
@@ -266,6 +268,8 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
                 t += 1
                 if rec is not None:
                     record_state(rec, t, reward, state)
+                    if t == table.noise.shape[1] - 1:  # a traced row of noise ends the run
+                        break
                 if terminated or truncated:
                     break
                 env_observe_row(okind, p, state, table.noise[e, t], obs)

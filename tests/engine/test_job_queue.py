@@ -12,7 +12,7 @@ import threading
 import numba
 import numpy as np
 
-from mtpg.engine.batch import Episodes, run_jobs
+from mtpg.engine.batch import BatchResult, Episodes, Jobs, run_jobs
 from mtpg.engine.compile import compile_population
 from mtpg.engine.kernels import _fetch_add, run_jobs_parallel, run_jobs_queue
 from mtpg.engine.workload import layered_graphs
@@ -32,10 +32,9 @@ def _setup(n_graphs=60, seeds=(0, 1, 2)):
 
 
 def _args(cp, job_roots, job_eps, episodes):
-    n = len(job_roots)
-    out = (np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
-    table = (episodes.tasks, episodes.starts, episodes.noise)
-    return out, (job_roots, job_eps, *table, TASK_PARAMS, False, *out, *cp.kernel_args())
+    out = BatchResult.zeros(len(job_roots))
+    table = episodes._replace(params=TASK_PARAMS)
+    return out, (Jobs(job_roots, job_eps), table, False, out, cp.graph)
 
 
 def test_serial_worker_takes_every_block_once():

@@ -60,3 +60,38 @@ def test_traced_episode_matches_batch_kernel():
             assert len(trace.actions) == result.steps[i]
             assert trace.teams_per_decision().sum() == result.teams[i]
             assert len(trace.instr_log) == result.instructions[i]
+
+
+def test_a_run_whose_logs_overflow_is_played_again_with_room_for_all(monkeypatch):
+    """Logs that outgrow the first buffers are counted, and the run is played again."""
+    from mtpg.engine import record
+    from mtpg.engine.workload import layered_graphs
+
+    pop, roots = layered_graphs(np.random.default_rng(5), 2, teams=3, programs=5, instructions=6)
+    cp = compile_population(pop)
+    starts, noise = make_episodes(np.array([0]), np.array([1]))
+    roomy = trace_episode(cp, roots[0], 0, starts[0], noise[0], snapshot=True)
+    monkeypatch.setattr(record, "FIRST_ROWS", 3)
+    played = []
+    real = record.new_recorder
+
+    def counting(*args):
+        played.append(1)
+        return real(*args)
+
+    monkeypatch.setattr(record, "new_recorder", counting)
+    tight = trace_episode(cp, roots[0], 0, starts[0], noise[0], snapshot=True)
+    assert len(played) == 2
+    for field in roomy.__dataclass_fields__:
+        assert np.array_equal(getattr(roomy, field), getattr(tight, field)), field
+
+
+def test_a_traced_episode_ends_where_its_noise_row_ends():
+    from mtpg.engine.workload import layered_graphs
+    from mtpg.envs.core import ACROBOT
+
+    pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=2, programs=4, instructions=4)
+    cp = compile_population(pop)
+    starts, noise = make_episodes(np.array([ACROBOT]), np.array([0]))  # up to 500 steps
+    trace = trace_episode(cp, roots[0], ACROBOT, starts[0], noise[0, :8])
+    assert len(trace.actions) == 7 and len(trace.states) == 8

@@ -12,10 +12,11 @@ import gymnasium
 import numpy as np
 import pytest
 
-from mtpg.engine.batch import Episodes, evaluate_roots
+from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.kernels import run_jobs_queue
-from mtpg.engine.trace import trace_episode, trace_kernel
+from mtpg.engine.record import new_recorder
+from mtpg.engine.trace import trace_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe, env_reset, env_step
 from mtpg.envs.core import N_TASKS, STATE_SIZE, STEP_SLOT
@@ -110,20 +111,14 @@ def test_an_id_without_a_branch_is_loud(graph):
     reward, terminated, truncated = env_step(missing, params, state, 0, 0.0)
     assert np.isnan(reward) and terminated and not truncated
     cp = compile_population(pop)
-    out = trace_kernel(
-        cp.team_index(root), missing, params, np.zeros(STATE_SIZE), np.zeros(201), np.zeros((0, 2)),
-        False, False, *cp.kernel_args(),
+    table = Episodes(
+        np.array([missing]), np.zeros(1, np.int64), np.zeros((1, STATE_SIZE)), np.zeros((1, 201)),
+        params,
     )  # fmt: skip
-    assert np.isnan(out[-1]).all() and len(out[0]) == 1 and np.isnan(out[1]).all()
-    ret, steps, teams, instr = (
-        np.zeros(1),
-        np.zeros(1, np.int64),
-        np.zeros(1, np.int64),
-        np.zeros(1, np.int64),
-    )
-    run_jobs_queue(
-        np.zeros(1, np.int64), 1, np.array([cp.team_index(root)]), np.zeros(1, np.int64),
-        np.array([missing]), np.zeros((1, STATE_SIZE)), np.zeros((1, 201)), params, False,
-        ret, steps, teams, instr, *cp.kernel_args(),
-    )  # fmt: skip
-    assert np.isnan(ret[0]) and steps[0] == 1
+    jobs = Jobs(np.array([cp.team_index(root)]), np.zeros(1, np.int64))
+    out = BatchResult.zeros(1)
+    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, False, out, cp.graph)
+    assert np.isnan(out.returns[0]) and out.steps[0] == 1
+    rec = new_recorder(cp.graph, np.full(4, 1000), 200, False)  # traced: the same loop
+    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, False, out, cp.graph, rec)
+    assert np.isnan(rec.observations[0]).all() and np.isnan(rec.rewards[0])

@@ -98,10 +98,10 @@ def write_input(work: Workload, path: Path) -> None:
     cp = work.cp
     starts, noise = work.pool.starts, work.pool.noise
     header = [
-        len(cp.team_offsets) - 1,
-        len(cp.team_members),
-        len(cp.prog_action),
-        len(cp.instrs),
+        len(cp.graph.team_offsets) - 1,
+        len(cp.graph.team_members),
+        len(cp.graph.prog_action),
+        len(cp.graph.instrs),
         cp.layout.n_registers,
         cp.layout.n_memory,
         cp.mem_base,
@@ -114,12 +114,12 @@ def write_input(work: Workload, path: Path) -> None:
     parts = [
         np.asarray(header, np.int64),
         np.asarray([BIG, DIV_EPS, LOG_BIG, LOG_TINY], np.float64),
-        cp.team_offsets.astype(np.int64),
-        cp.team_members.astype(np.int64),
-        cp.prog_offsets.astype(np.int64),
-        cp.instrs.astype(np.uint32),
-        cp.prog_action.astype(np.int64),
-        cp.prog_bank.astype(np.int64),
+        cp.graph.team_offsets.astype(np.int64),
+        cp.graph.team_members.astype(np.int64),
+        cp.graph.prog_offsets.astype(np.int64),
+        cp.graph.instrs.astype(np.uint32),
+        cp.graph.prog_action.astype(np.int64),
+        cp.graph.prog_bank.astype(np.int64),
         work.job_roots.astype(np.int64),
         work.job_episodes.astype(np.int64),
         starts.astype(np.float64),

@@ -24,9 +24,8 @@ import numpy as np
 
 from mtpg.bench.workload import Workload, drive, make_workload, warm_up
 from mtpg.engine.batch import BatchResult
-from mtpg.engine.reference import ReferenceAgent
-from mtpg.envs import CARTPOLE, TASK_PARAMS, env_observe, env_reset, env_step
-from mtpg.envs.core import STATE_SIZE
+from mtpg.engine.reference import ReferenceAgent, reference_episode
+from mtpg.envs import CARTPOLE
 from mtpg.model.graph import Population
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
@@ -49,11 +48,30 @@ class ReferenceRun:
     observations: list[np.ndarray]
 
 
+class _TimedAgent:
+    """A reference agent that times its decisions and keeps the observation of each."""
+
+    def __init__(self, agent: ReferenceAgent) -> None:
+        self.agent = agent
+        self.seconds = 0.0
+        self.seen: list[np.ndarray] = []
+
+    def reset(self) -> None:
+        self.agent.reset()
+
+    def act(self, obs: np.ndarray):
+        self.seen.append(np.array(obs, dtype=np.float64))
+        t0 = time.perf_counter()
+        decision = self.agent.act(obs)
+        self.seconds += time.perf_counter() - t0
+        return decision
+
+
 def run_reference(work: Workload, graphs: int) -> ReferenceRun:
     """Plays the jobs of the first ``graphs`` graphs with the reference interpreter.
 
-    The episodes are those of the same jobs in the workload; only the calls to ``act``
-    are timed.
+    The episodes are those of the same jobs in the workload, played by
+    :func:`~mtpg.engine.reference.reference_episode`; only the calls to ``act`` are timed.
 
     Args:
         work: The workload.
@@ -66,32 +84,16 @@ def run_reference(work: Workload, graphs: int) -> ReferenceRun:
     n_jobs = graphs * work.episodes
     returns, steps = np.zeros(n_jobs), np.zeros(n_jobs, np.int64)
     observations = []
-    state = np.zeros(STATE_SIZE)
-    obs = np.zeros(2)
     seconds = 0.0
-    clock = time.perf_counter
     for g in range(graphs):
-        agent = ReferenceAgent(work.pop, work.root_ids[g])
-        seen = []
+        agent = _TimedAgent(ReferenceAgent(work.pop, work.root_ids[g]))
         for j in range(g * work.episodes, (g + 1) * work.episodes):
             e = int(work.job_episodes[j])
-            agent.reset()
-            env_reset(CARTPOLE, TASK_PARAMS, work.pool.starts[e], state)
-            env_observe(CARTPOLE, TASK_PARAMS, state, work.pool.noise[e, 0], obs)
-            while True:
-                seen.append(obs.copy())
-                t0 = clock()
-                d = agent.act(obs)
-                seconds += clock() - t0
-                reward, terminated, truncated = env_step(
-                    CARTPOLE, TASK_PARAMS, state, d.action, d.continuous
-                )
-                returns[j] += reward
-                steps[j] += 1
-                if terminated or truncated:
-                    break
-                env_observe(CARTPOLE, TASK_PARAMS, state, work.pool.noise[e, steps[j]], obs)
-        observations.append(np.array(seen).reshape(-1, 2))
+            returns[j], steps[j] = reference_episode(
+                agent, CARTPOLE, work.pool.starts[e], work.pool.noise[e]
+            )
+        seconds += agent.seconds
+        observations.append(np.array(agent.seen).reshape(-1, 2))
     zeros = np.zeros(n_jobs, np.int64)
     result = BatchResult(returns, steps, zeros, zeros.copy())
     return ReferenceRun(int(steps.sum()), seconds, result, observations)
@@ -280,6 +282,127 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, 
     return pairs
 
 
+def _time_engine(work: Workload, threads: int, repeats: int, say) -> tuple[list, list]:
+    """The timed compiled runs, and above one thread the one-thread run paired with each.
+
+    Raises:
+        RuntimeError: Two runs disagree on any job (between repeats or thread counts).
+    """
+    runs, singles = [], []
+    for r in range(repeats):
+        if threads > 1:  # the scaling: one-thread runs interleaved with the N-thread runs
+            singles.append(drive(work, 1))
+        res = drive(work, threads)
+        runs.append(res)
+        say(
+            f"  run {r + 1}/{repeats}: {res.decisions / res.seconds:,.0f} decisions/s"
+            + (f" (1 thread: {res.decisions / singles[-1].seconds:,.0f})" if singles else "")
+        )
+    for res in runs[1:] + singles:
+        if not _same_result(res.result, runs[0].result):
+            raise RuntimeError("compiled runs disagree between repeats or thread counts")
+    return runs, singles
+
+
+def _checked_reference(work: Workload, engine: BatchResult, graphs: int, say):
+    """The reference interpreter on the first ``graphs`` graphs, checked against the engine.
+
+    Raises:
+        RuntimeError: A played job's return or length differs from the engine's.
+    """
+    say(f"reference interpreter on {graphs} graphs ...")
+    ref = run_reference(work, graphs)
+    played = slice(0, graphs * work.episodes)
+    if not (
+        np.array_equal(ref.result.steps, engine.steps[played])
+        and np.array_equal(ref.result.returns, engine.returns[played])
+    ):
+        raise RuntimeError("reference interpreter and compiled engine disagree")
+    return ref
+
+
+def _time_c(work: Workload, engine: BatchResult, repeats: int, say, c_flags, c_beside):
+    """The C builds asked for (:func:`_c_runs`): the main flags, then those beside."""
+    say("the same work in C (interleaved with one-thread engine runs) ...")
+    from mtpg.bench.c_port import C_FLAGS, C_FLAGS_BESIDE
+
+    c_flags = tuple(c_flags) if c_flags else C_FLAGS
+    c_beside = C_FLAGS_BESIDE if c_beside is None else tuple(c_beside)
+    builds = [c_flags] + ([c_beside] if c_beside and c_beside != c_flags else [])
+    return _c_runs(work, engine, repeats, say, lambda: drive(work, 1), builds)
+
+
+def _summary(work: Workload, runs: list, threads: int, ref: ReferenceRun | None, pt) -> dict:
+    """The figures of the compiled runs and the Python baselines (see ``mtpg bench engine``)."""
+    first = runs[0].result
+    seconds = statistics.median(r.seconds for r in runs)
+    decisions = runs[0].decisions
+    rate = decisions / seconds
+    ref_rate = ref.decisions / ref.seconds if ref is not None and ref.seconds > 0 else None
+    pt_rate = pt["decisions"] / pt["seconds"] if pt and pt["seconds"] > 0 else None
+    executed = int(first.instructions.sum())
+    return {
+        "decisions_per_s": rate,
+        "instructions_per_decision": executed / decisions,
+        "teams_per_decision": int(first.teams.sum()) / decisions,
+        "instructions_per_s": executed / seconds,
+        "threads": threads,
+        "reference_decisions_per_s": ref_rate,
+        "pytpg_decisions_per_s": pt_rate,
+        "speedup_vs_reference": rate / ref_rate if ref_rate else None,
+        "speedup_vs_pytpg": rate / pt_rate if pt_rate else None,
+        "pytpg_teams_per_decision": pt["teams"] / pt["decisions"] if pt else None,
+        "one_thread_decisions_per_s": None,
+        "scaling": None,
+        "c_decisions_per_s": None,
+        "engine_cpu_decisions_per_s": None,
+        "engine_vs_c": None,
+        "graphs": work.n_graphs,
+        "teams": work.teams,
+        "programs": work.programs,
+        "instructions": work.instructions,
+        "episodes": work.episodes,
+        "decisions": decisions,
+        "pointer_fraction": work.pointer_fraction,
+        "effective_instruction_fraction": len(work.cp.graph.instrs)
+        / int(work.cp.n_instructions.sum()),
+        "repeats": len(runs),
+        "seconds": seconds,
+        "seconds_all": [r.seconds for r in runs],
+        "build_seconds": work.build_seconds,
+    }
+
+
+def _scaling(runs: list, singles: list) -> dict:
+    """The one-thread rate and the median over pairs of one-thread over N-thread time."""
+    scaling = [a.seconds / b.seconds for a, b in zip(singles, runs, strict=True)]
+    return {
+        "one_thread_decisions_per_s": runs[0].decisions
+        / statistics.median(a.seconds for a in singles),
+        "scaling": statistics.median(scaling),
+        "scaling_all": scaling,
+    }
+
+
+def _c_figures(c_pairs: dict, decisions: int) -> dict:
+    """The C builds' figures: the first build's at the top level, the next as ``c_beside``."""
+    out = {}
+    for k, (flags, (c_cpu, e_cpu)) in enumerate(c_pairs.items()):
+        ratios = [cc / ee for cc, ee in zip(c_cpu, e_cpu, strict=True)]
+        figures = {
+            "c_decisions_per_s": decisions / statistics.median(c_cpu),
+            "engine_cpu_decisions_per_s": decisions / statistics.median(e_cpu),
+            "engine_vs_c": statistics.median(ratios),
+            "engine_vs_c_all": ratios,
+            "c_flags": " ".join(flags),
+        }
+        if k == 0:
+            out.update(figures)
+        else:
+            out["c_beside"] = figures
+    return out
+
+
 def benchmark(
     graphs: int = 3000,
     teams: int = 3,
@@ -332,102 +455,19 @@ def benchmark(
     warm_up(threads)
     say(f"building {graphs} graphs ...")
     work = make_workload(graphs, teams, programs, instructions, episodes, seed)
-    runs, singles = [], []
-    for r in range(repeats):
-        if threads > 1:  # the scaling: one-thread runs interleaved with the N-thread runs
-            singles.append(drive(work, 1))
-        res = drive(work, threads)
-        runs.append(res)
-        say(
-            f"  run {r + 1}/{repeats}: {res.decisions / res.seconds:,.0f} decisions/s"
-            + (f" (1 thread: {res.decisions / singles[-1].seconds:,.0f})" if singles else "")
-        )
+    runs, singles = _time_engine(work, threads, repeats, say)
     first = runs[0].result
-    for res in runs[1:] + singles:
-        if not _same_result(res.result, first):
-            raise RuntimeError("compiled runs disagree between repeats or thread counts")
-    seconds = statistics.median(r.seconds for r in runs)
-    decisions = runs[0].decisions
     record = min(reference_graphs, graphs)
-    ref = None
-    if record:
-        say(f"reference interpreter on {record} graphs ...")
-        ref = run_reference(work, record)
-        played = slice(0, record * episodes)
-        if not (
-            np.array_equal(ref.result.steps, first.steps[played])
-            and np.array_equal(ref.result.returns, first.returns[played])
-        ):
-            raise RuntimeError("reference interpreter and compiled engine disagree")
+    ref = _checked_reference(work, first, record, say) if record else None
     pt = None
     if pytpg and ref is not None:
         say(f"pytpg on {record} graphs ...")
         pt = run_pytpg(work, ref, seed)
-    c_pairs = None
-    if c:
-        say("the same work in C (interleaved with one-thread engine runs) ...")
-        from mtpg.bench.c_port import C_FLAGS, C_FLAGS_BESIDE
-
-        c_flags = tuple(c_flags) if c_flags else C_FLAGS
-        c_beside = C_FLAGS_BESIDE if c_beside is None else tuple(c_beside)
-        builds = [c_flags] + ([c_beside] if c_beside and c_beside != c_flags else [])
-        c_pairs = _c_runs(work, first, repeats, say, lambda: drive(work, 1), builds)
-    rate = decisions / seconds
-    ref_rate = ref.decisions / ref.seconds if ref is not None and ref.seconds > 0 else None
-    pt_rate = pt["decisions"] / pt["seconds"] if pt and pt["seconds"] > 0 else None
-    executed = int(first.instructions.sum())
-    total_instr = int(work.cp.n_instructions.sum())
-    out = {
-        "decisions_per_s": rate,
-        "instructions_per_decision": executed / decisions,
-        "teams_per_decision": int(first.teams.sum()) / decisions,
-        "instructions_per_s": executed / seconds,
-        "threads": threads,
-        "reference_decisions_per_s": ref_rate,
-        "pytpg_decisions_per_s": pt_rate,
-        "speedup_vs_reference": rate / ref_rate if ref_rate else None,
-        "speedup_vs_pytpg": rate / pt_rate if pt_rate else None,
-        "pytpg_teams_per_decision": pt["teams"] / pt["decisions"] if pt else None,
-        "one_thread_decisions_per_s": None,
-        "scaling": None,
-        "c_decisions_per_s": None,
-        "engine_cpu_decisions_per_s": None,
-        "engine_vs_c": None,
-        "graphs": graphs,
-        "teams": teams,
-        "programs": programs,
-        "instructions": instructions,
-        "episodes": episodes,
-        "decisions": decisions,
-        "pointer_fraction": work.pointer_fraction,
-        "effective_instruction_fraction": len(work.cp.instrs) / total_instr,
-        "repeats": repeats,
-        "seconds": seconds,
-        "seconds_all": [r.seconds for r in runs],
-        "build_seconds": work.build_seconds,
-        "reference_graphs": record,
-        "seed": seed,
-        "machine": machine_info(),
-    }
+    c_pairs = _time_c(work, first, repeats, say, c_flags, c_beside) if c else None
+    out = _summary(work, runs, threads, ref, pt)
+    out.update(reference_graphs=record, seed=seed, machine=machine_info())
     if singles:
-        scaling = [a.seconds / b.seconds for a, b in zip(singles, runs, strict=True)]
-        out["one_thread_decisions_per_s"] = decisions / statistics.median(
-            a.seconds for a in singles
-        )
-        out["scaling"] = statistics.median(scaling)
-        out["scaling_all"] = scaling
+        out.update(_scaling(runs, singles))
     if c_pairs is not None:
-        for k, (flags, (c_cpu, e_cpu)) in enumerate(c_pairs.items()):
-            ratios = [cc / ee for cc, ee in zip(c_cpu, e_cpu, strict=True)]
-            figures = {
-                "c_decisions_per_s": decisions / statistics.median(c_cpu),
-                "engine_cpu_decisions_per_s": decisions / statistics.median(e_cpu),
-                "engine_vs_c": statistics.median(ratios),
-                "engine_vs_c_all": ratios,
-                "c_flags": " ".join(flags),
-            }
-            if k == 0:
-                out.update(figures)
-            else:
-                out["c_beside"] = figures
+        out.update(_c_figures(c_pairs, runs[0].decisions))
     return out

@@ -139,7 +139,7 @@ def make_workload(
         teams=teams,
         programs=programs,
         instructions=instructions,
-        pointer_fraction=float(np.mean(cp.prog_action >= 0)),
+        pointer_fraction=float(np.mean(cp.graph.prog_action >= 0)),
         build_seconds=build,
     )
 

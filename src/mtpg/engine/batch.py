@@ -1,8 +1,12 @@
-"""Evaluation of many roots x tasks x episodes in one compiled call."""
+"""Evaluation of many roots x tasks x episodes in one compiled call.
+
+The episode table, the jobs and the outputs are named tuples of arrays, each passed to the
+kernels as one argument (:mod:`mtpg.engine.kernels`).
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -13,9 +17,8 @@ from mtpg.envs import make_episodes
 from mtpg.envs.variants import task_params
 
 
-@dataclass(frozen=True)
-class Episodes:
-    """A table of episodes: task, start state and noise row of each.
+class Episodes(NamedTuple):
+    """A table of episodes: task, start state and noise row of each (a kernel argument).
 
     Attributes:
         tasks: int64 ``[n]`` task ids.
@@ -43,6 +46,17 @@ class Episodes:
         )
 
     @classmethod
+    def single(cls, task: int, start: np.ndarray, noise: np.ndarray) -> Episodes:
+        """A table of one given episode: ``task`` from ``start`` with the ``noise`` row."""
+        return cls(
+            np.array([task], dtype=np.int64),
+            np.zeros(1, dtype=np.int64),
+            np.ascontiguousarray(start, dtype=np.float64).reshape(1, -1),
+            np.ascontiguousarray(noise, dtype=np.float64).reshape(1, -1),
+            task_params(),
+        )
+
+    @classmethod
     def grid(cls, tasks: list[int], seeds: list[int] | np.ndarray) -> Episodes:
         """Every task with every seed, task-major: episode ``i * len(seeds) + k``."""
         seeds = np.asarray(seeds, dtype=np.int64)
@@ -51,9 +65,22 @@ class Episodes:
         )
 
 
-@dataclass(frozen=True)
-class BatchResult:
-    """Per-job outcomes of :func:`run_jobs`.
+class Jobs(NamedTuple):
+    """The jobs of a batch (a kernel argument).
+
+    Job ``j`` plays row ``episodes[j]`` of the episode table with dense root ``roots[j]``.
+
+    Attributes:
+        roots: int64 ``[n_jobs]`` dense team indices.
+        episodes: int64 ``[n_jobs]`` rows of the episode table.
+    """
+
+    roots: np.ndarray
+    episodes: np.ndarray
+
+
+class BatchResult(NamedTuple):
+    """Per-job outcomes of :func:`run_jobs` (the kernels' output argument).
 
     Attributes:
         returns: float64 ``[n_jobs]`` episode returns.
@@ -66,6 +93,11 @@ class BatchResult:
     steps: np.ndarray
     teams: np.ndarray
     instructions: np.ndarray
+
+    @classmethod
+    def zeros(cls, n: int) -> BatchResult:
+        """Outputs for ``n`` jobs, zeroed."""
+        return cls(np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
 
 
 def run_jobs(
@@ -100,31 +132,18 @@ def run_jobs(
         raise ValueError(f"threads must be >= 1, got {threads}")
     if block < 1:
         raise ValueError(f"block must be >= 1, got {block}")
-    n = len(job_roots)
-    out = BatchResult(
-        np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64)
-    )
-    args = (
+    out = BatchResult.zeros(len(job_roots))
+    jobs = Jobs(
         np.ascontiguousarray(job_roots, dtype=np.int64),
         np.ascontiguousarray(job_episodes, dtype=np.int64),
-        episodes.tasks,
-        episodes.starts,
-        episodes.noise,
-        episodes.params,
-        no_memory,
-        out.returns,
-        out.steps,
-        out.teams,
-        out.instructions,
-        *cp.kernel_args(),
     )
     queue = np.zeros(1, dtype=np.int64)
     if threads == 1:
-        run_jobs_queue(queue, block, *args)
+        run_jobs_queue(queue, block, jobs, episodes, no_memory, out, cp.graph)
     else:
         threads = min(threads, numba.config.NUMBA_NUM_THREADS)
         numba.set_num_threads(threads)
-        run_jobs_parallel(threads, queue, block, *args)
+        run_jobs_parallel(threads, queue, block, jobs, episodes, no_memory, out, cp.graph)
     return out
 
 

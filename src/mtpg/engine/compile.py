@@ -20,6 +20,7 @@ uses (a fresh bank) can never be read or written, so it needs no workspace.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -34,17 +35,17 @@ from mtpg.model.instructions import (
 )
 
 
-@dataclass(frozen=True)
-class CompiledPopulation:
-    """A population as flat arrays.
+class Graph(NamedTuple):
+    """The compiled graph as every kernel takes it: one argument, unpacked in the kernel.
+
+    A named tuple of arrays and sizes (Numba passes it as one typed argument), so two
+    arrays can never be swapped at a call. The kernels read it in
+    :func:`mtpg.engine.kernels.decide`; docs/engine.md says where a new array goes.
 
     Attributes:
-        layout: Register sizes.
-        team_ids: int64 ``[n_teams]``: model team id of each dense team index.
         team_offsets: int64 ``[n_teams + 1]``: members of team ``t`` are
             ``team_members[team_offsets[t]:team_offsets[t + 1]]``.
         team_members: int64: dense program indices, in execution order.
-        program_ids: int64 ``[n_programs]``: model program id of each dense index.
         prog_offsets: int64 ``[n_programs + 1]``: effective instructions of program ``p``
             are ``instrs[prog_offsets[p]:prog_offsets[p + 1]]``.
         instrs: uint32 ``[n, 4]``: ``op, dst, src1, src2`` as workspace indices (unsigned:
@@ -52,26 +53,46 @@ class CompiledPopulation:
         prog_action: int64 ``[n_programs]``: dense team index, or ``-1 - a`` for atomic
             action ``a``.
         prog_bank: int64 ``[n_programs]``: dense memory bank index.
+        n_registers: Private registers per program (``R``).
+        n_memory: Registers per memory bank (``M``).
+        mem_base: Workspace index of memory bank 0.
+    """
+
+    team_offsets: np.ndarray
+    team_members: np.ndarray
+    prog_offsets: np.ndarray
+    instrs: np.ndarray
+    prog_action: np.ndarray
+    prog_bank: np.ndarray
+    n_registers: int
+    n_memory: int
+    mem_base: int
+
+
+@dataclass(frozen=True)
+class CompiledPopulation:
+    """A population as flat arrays: the kernels' :class:`Graph` and the ids behind it.
+
+    Attributes:
+        layout: Register sizes.
+        graph: What the kernels execute (dense indices throughout).
+        team_ids: int64 ``[n_teams]``: model team id of each dense team index.
+        program_ids: int64 ``[n_programs]``: model program id of each dense index.
         bank_ids: int64 ``[n_banks]``: model bank id of each dense bank index.
         n_instructions: int64 ``[n_programs]``: instructions before intron removal.
     """
 
     layout: RegisterLayout
+    graph: Graph
     team_ids: np.ndarray
-    team_offsets: np.ndarray
-    team_members: np.ndarray
     program_ids: np.ndarray
-    prog_offsets: np.ndarray
-    instrs: np.ndarray
-    prog_action: np.ndarray
-    prog_bank: np.ndarray
     bank_ids: np.ndarray
     n_instructions: np.ndarray
 
     @property
     def mem_base(self) -> int:
         """Workspace index of the first memory register."""
-        return self.layout.n_registers + N_CONSTANTS + self.layout.n_obs
+        return self.graph.mem_base
 
     @property
     def workspace_size(self) -> int:
@@ -85,20 +106,6 @@ class CompiledPopulation:
     def bank_index(self, bank_id: int) -> int:
         """Dense index of a model bank id."""
         return int(np.searchsorted(self.bank_ids, bank_id))
-
-    def kernel_args(self) -> tuple:
-        """The arrays and sizes every kernel takes, in kernel argument order."""
-        return (
-            self.team_offsets,
-            self.team_members,
-            self.prog_offsets,
-            self.instrs,
-            self.prog_action,
-            self.prog_bank,
-            self.layout.n_registers,
-            self.layout.n_memory,
-            self.mem_base,
-        )
 
 
 @njit(cache=True, error_model="numpy")
@@ -219,16 +226,22 @@ def compile_population(pop: Population, remove_introns: bool = True) -> Compiled
     instrs = np.empty_like(code, dtype=np.uint32)
     instrs[:, 0] = code[:, 0]
     instrs[:, 1:] = mapped
-    return CompiledPopulation(
-        layout=layout,
-        team_ids=team_ids,
+    graph = Graph(
         team_offsets=np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
         team_members=team_members.astype(np.int64),
-        program_ids=program_ids,
         prog_offsets=np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64),
         instrs=instrs,
         prog_action=prog_action,
         prog_bank=prog_bank.astype(np.int64),
+        n_registers=r,
+        n_memory=m,
+        mem_base=mem_base,
+    )
+    return CompiledPopulation(
+        layout=layout,
+        graph=graph,
+        team_ids=team_ids,
+        program_ids=program_ids,
         bank_ids=bank_ids.astype(np.int64),
         n_instructions=np.array([len(p.instructions) for p in progs], dtype=np.int64),
     )

@@ -29,8 +29,8 @@ import warnings
 
 import numpy as np
 
-from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
-from mtpg.engine.compile import CompiledPopulation
+from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots
+from mtpg.engine.compile import CompiledPopulation, Graph
 from mtpg.engine.evaluator import BackendError, BackendLost
 from mtpg.engine.kernels import run_jobs_queue
 
@@ -75,16 +75,16 @@ def scheduler_wait() -> float:
     return value
 
 
-def graph_arrays(cp: CompiledPopulation) -> tuple:
+def graph_arrays(cp: CompiledPopulation) -> Graph:
     """The compiled graph as the kernels take it: arrays and three ints, no model objects."""
-    return cp.kernel_args()
+    return cp.graph
 
 
 def play_batch(
-    graph: tuple,
+    graph: Graph,
     job_roots: np.ndarray,
     job_eps: np.ndarray,
-    table: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    table: Episodes,
     no_memory: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Plays one batch of jobs serially (runs on a worker).
@@ -93,17 +93,16 @@ def play_batch(
         graph: :func:`graph_arrays` of the compiled population.
         job_roots: int64 dense team index of each job.
         job_eps: int64 episode row of each job.
-        table: The episode table's ``tasks``, ``starts``, ``noise`` and ``params`` arrays
-            (the parameter table travels with the episodes, variants' rows included).
+        table: The episode table (the parameter table travels with the episodes,
+            variants' rows included).
         no_memory: The memory ablation switch.
 
     Returns:
         ``returns, steps, teams, instructions`` of the batch's jobs, in order.
     """
-    n = len(job_roots)
-    out = (np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64))
+    out = BatchResult.zeros(len(job_roots))
     queue = np.zeros(1, dtype=np.int64)
-    run_jobs_queue(queue, 1, job_roots, job_eps, *table, no_memory, *out, *graph)
+    run_jobs_queue(queue, 1, Jobs(job_roots, job_eps), table, no_memory, out, graph)
     return out
 
 
@@ -313,8 +312,7 @@ class DaskEvaluator:
         if key not in self._tables:
             if len(self._tables) >= TABLES_KEPT:
                 self._tables.pop(next(iter(self._tables))).release()
-            arrays = (episodes.tasks, episodes.starts, episodes.noise, episodes.params)
-            [self._tables[key]] = self.client.scatter([arrays], broadcast=True, hash=False)
+            [self._tables[key]] = self.client.scatter([episodes], broadcast=True, hash=False)
         return self._tables[key]
 
     def check(self) -> None:

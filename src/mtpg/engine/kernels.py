@@ -1,9 +1,15 @@
 """Compiled decision, episode and batch kernels.
 
-Every kernel takes the compiled graph as the argument group
-``team_offsets, team_members, prog_offsets, instrs, prog_action, prog_bank, R, M, base``
-(see :class:`~mtpg.engine.compile.CompiledPopulation.kernel_args`) and a per-thread
-float64 workspace ``W`` laid out as documented in :mod:`mtpg.engine.compile`.
+Every kernel takes its arrays as a few named tuples, each unpacked once in the kernel: the
+compiled graph (:class:`~mtpg.engine.compile.Graph`), the jobs and the episode table
+(:class:`~mtpg.engine.batch.Jobs`, :class:`~mtpg.engine.batch.Episodes`), the outputs
+(:class:`~mtpg.engine.batch.BatchResult`) and one thread's private :class:`Buffers`, whose
+float64 workspace ``W`` is laid out as documented in :mod:`mtpg.engine.compile`.
+
+The decision semantics live in :func:`decide` alone and the episode loop in
+:func:`run_jobs_queue` alone: the tracer (:mod:`mtpg.engine.trace`) runs the same two with
+a :class:`~mtpg.engine.record.Recorder`, and the training path passes ``rec=None``, with
+which Numba compiles every recording branch out.
 
 Memory banks are reset lazily: ``bank_stamp[b]`` records the episode in which bank ``b``
 was last zeroed, and a program zeroes its bank before running when the stamp is stale.
@@ -13,12 +19,23 @@ each episode. Visited teams are marked the same way with a per-decision stamp.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit, prange, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
 from mtpg.engine.ops import apply_op
+from mtpg.engine.record import (
+    record_decision,
+    record_instruction,
+    record_observation,
+    record_program,
+    record_reset,
+    record_state,
+    record_team,
+)
 from mtpg.envs.core import STATE_SIZE
 from mtpg.envs.kernels import env_observe_row, env_reset, observe_kind, task_step
 from mtpg.envs.tasks import P_KIND
@@ -47,44 +64,52 @@ def _fetch_add(typingctx, counter):
 
 
 @njit(cache=True, error_model="numpy")
-def new_workspace(size: int, R: int) -> np.ndarray:  # noqa: N803
+def new_workspace(size: int, R: int) -> np.ndarray:
     """Allocates a zeroed workspace with the constants in place."""
-    W = np.zeros(size)  # noqa: N806
+    W = np.zeros(size)
     for i in range(N_CONSTANTS):
         W[R + i] = _CONSTANTS[i]
     return W
 
 
+class Buffers(NamedTuple):
+    """One thread's private state, allocated once per worker (:func:`thread_buffers`).
+
+    Attributes:
+        W: float64 workspace (registers, constants, observation, every bank).
+        obs: The observation slots of ``W`` (a view).
+        team_stamp: int64 ``[n_teams]`` visit marks (the decision's stamp: visited).
+        bank_stamp: int64 ``[n_banks]`` episode marks of the banks' last reset.
+        state: float64 ``[STATE_SIZE]`` the task state.
+        counts: int64 ``[2]`` teams visited and instructions executed in the episode.
+    """
+
+    W: np.ndarray
+    obs: np.ndarray
+    team_stamp: np.ndarray
+    bank_stamp: np.ndarray
+    state: np.ndarray
+    counts: np.ndarray
+
+
 @njit(cache=True, error_model="numpy")
-def thread_buffers(team_offsets, prog_bank, R, M, base):  # noqa: N803
-    """One thread's private state: workspace, visit and bank stamps, task state, counters."""
-    n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
-    W = new_workspace(base + n_banks * M, R)  # noqa: N806
-    team_stamp = np.full(len(team_offsets) - 1, -1, dtype=np.int64)
-    bank_stamp = np.full(n_banks, -1, dtype=np.int64)
-    return W, team_stamp, bank_stamp, np.zeros(STATE_SIZE), np.zeros(2, dtype=np.int64)
+def thread_buffers(g) -> Buffers:
+    """Allocates one thread's :class:`Buffers` for the compiled graph ``g``."""
+    R, M, base = g.n_registers, g.n_memory, g.mem_base
+    n_banks = (g.prog_bank.max() + 1) if len(g.prog_bank) else 0
+    W = new_workspace(base + n_banks * M, R)
+    return Buffers(
+        W,
+        W[R + N_CONSTANTS : R + N_CONSTANTS + 2],
+        np.full(len(g.team_offsets) - 1, -1, dtype=np.int64),
+        np.full(n_banks, -1, dtype=np.int64),
+        np.zeros(STATE_SIZE),
+        np.zeros(2, dtype=np.int64),
+    )
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def decide(
-    root,
-    W,
-    team_stamp,
-    stamp,
-    bank_stamp,
-    episode,
-    no_memory,
-    counts,
-    team_offsets,
-    team_members,
-    prog_offsets,
-    instrs,
-    prog_action,
-    prog_bank,
-    R,
-    M,
-    base,
-):  # noqa: N803
+def decide(g, buf, root, stamp, episode, no_memory, rec):
     """Makes one decision: traverses the graph from ``root`` to an atomic action.
 
     Written as one flat loop nest on purpose: helper functions taking arrays cost an
@@ -98,27 +123,21 @@ def decide(
     (ties go to the earlier program).
 
     Args:
+        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
+        buf: The thread's :class:`Buffers`, the observation in place.
         root: Dense index of the root team.
-        W: Workspace with the observation in place.
-        team_stamp: int64 ``[n_teams]`` visit marks; ``stamp`` must be new per decision.
-        stamp: This decision's mark.
-        bank_stamp: int64 ``[n_banks]`` episode marks of the banks.
-        episode: This episode's mark.
+        stamp: This decision's mark (new per decision).
+        episode: This episode's mark (new per episode: the lazy bank reset).
         no_memory: Zero each bank before every program execution (ablation).
-        counts: int64 ``[2]`` accumulators: teams visited, instructions executed.
-        team_offsets: The compiled graph (see ``CompiledPopulation``).
-        team_members: The compiled graph.
-        prog_offsets: The compiled graph.
-        instrs: The compiled graph.
-        prog_action: The compiled graph.
-        prog_bank: The compiled graph.
-        R: Private registers per program.
-        M: Registers per memory bank.
-        base: Workspace index of memory bank 0.
+        rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` to log into.
 
     Returns:
         ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
     """
+    team_offsets, team_members, prog_offsets = g.team_offsets, g.team_members, g.prog_offsets
+    instrs, prog_action, prog_bank = g.instrs, g.prog_action, g.prog_bank
+    R, M, base = g.n_registers, g.n_memory, g.mem_base
+    W, team_stamp, bank_stamp, counts = buf.W, buf.team_stamp, buf.bank_stamp, buf.counts
     # Every index below is unsigned (np.uint64): Numba then emits plain loads and stores,
     # without the fix-up for negative (from-the-end) indices that a signed index costs at
     # every access (and that turned the bank reset into scatter stores).
@@ -134,6 +153,8 @@ def decide(
     while True:
         team_stamp[team] = stamp
         n_teams += 1
+        if rec is not None:
+            record_team(rec, team)
         found = False
         best_p = np.uint64(0)
         best = 0.0
@@ -145,6 +166,8 @@ def decide(
                 for j in range(off, off + u_m):
                     W[j] = 0.0
                 bank_stamp[bank] = episode
+                if rec is not None:
+                    record_reset(rec, bank, M)
             if R == 8:  # the common size: straight-line stores
                 W[0] = W[1] = W[2] = W[3] = W[4] = W[5] = W[6] = W[7] = zero
             else:
@@ -153,9 +176,14 @@ def decide(
             lo, hi = np.uint64(prog_offsets[p]), np.uint64(prog_offsets[p + one])
             for i in range(lo, hi):
                 dst = instrs[i, 1]
-                W[dst] = apply_op(instrs[i, 0], W[dst], W[instrs[i, 2]], W[instrs[i, 3]])
+                value = apply_op(instrs[i, 0], W[dst], W[instrs[i, 2]], W[instrs[i, 3]])
+                if rec is not None:
+                    record_instruction(rec, i, instrs[i], W[dst], value, base, M)
+                W[dst] = value
             n_instr += hi - lo
             bid = W[0]
+            if rec is not None:
+                record_program(rec, p, bid)
             act = prog_action[p]
             if (act < 0 or team_stamp[np.uint64(act)] != stamp) and (not found or bid > best):
                 best = bid
@@ -170,31 +198,11 @@ def decide(
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_jobs_queue(
-    next_block,
-    block,
-    job_root,
-    job_ep,
-    ep_task,
-    ep_start,
-    ep_noise,
-    params,
-    no_memory,
-    out_return,
-    out_steps,
-    out_teams,
-    out_instr,
-    team_offsets,
-    team_members,
-    prog_offsets,
-    instrs,
-    prog_action,
-    prog_bank,
-    R,
-    M,
-    base,
-):  # noqa: N803
+def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
     """One worker: takes blocks of jobs from a shared queue and plays them serially.
+
+    Holds the package's one compiled episode loop: the batch kernels run it with
+    ``rec=None`` (Numba compiles the recording out), the tracer with a recorder.
 
     Jobs go in blocks of ``block`` consecutive jobs; block ``b`` is jobs
     ``b * block ... (b + 1) * block - 1``. The queue is the int64 counter ``next_block[0]``:
@@ -202,7 +210,7 @@ def run_jobs_queue(
     workers sharing one counter (:func:`run_jobs_parallel`) balance long and short
     episodes among themselves whatever their speed, and a worker with a counter of its own
     plays every job in order. Consecutive jobs usually share a root (all its episodes), so a
-    block keeps one graph's code and memory banks in cache. The private workspace is
+    block keeps one graph's code and memory banks in cache. The private buffers are
     allocated once per worker, not per block.
 
     Results do not depend on which worker plays a job: every job starts from a fresh
@@ -210,89 +218,69 @@ def run_jobs_queue(
 
     Releases the GIL, so several Python threads (e.g. of one Dask worker) run it at once.
 
-    Job ``j`` plays episode ``job_ep[j]`` (task ``ep_task``, start state ``ep_start`` and
-    noise ``ep_noise`` rows) with root ``job_root[j]`` and writes its return, steps,
-    teams visited and instructions executed to the ``out_*`` arrays at ``j``.
+    Args:
+        next_block: int64 ``[1]``: the queue's counter.
+        block: Jobs per block.
+        jobs: :class:`~mtpg.engine.batch.Jobs`: job ``j`` plays episode row
+            ``jobs.episodes[j]`` with root ``jobs.roots[j]``.
+        table: :class:`~mtpg.engine.batch.Episodes`: task, start state and noise row of
+            each episode, and the parameter table the task ids index.
+        no_memory: The no-memory ablation.
+        out: :class:`~mtpg.engine.batch.BatchResult`: job ``j``'s return, steps, teams
+            visited and instructions executed are written at ``j``.
+        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
+        rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` of a one-job run
+            (which also ends where the episode's noise row ends, as a time limit that
+            would read past it cannot occur in a table of ``make_episodes``).
     """
-    W, team_stamp, bank_stamp, state, counts = thread_buffers(team_offsets, prog_bank, R, M, base)  # noqa: N806
-    obs = W[R + N_CONSTANTS : R + N_CONSTANTS + 2]
+    buf = thread_buffers(g)
+    obs, state, counts = buf.obs, buf.state, buf.counts
     stamp = 0
-    n_jobs = len(job_root)
+    n_jobs = len(jobs.roots)
     while True:
         first = _fetch_add(next_block) * block
         if first >= n_jobs:
             break
         for j in range(first, min(first + block, n_jobs)):
-            e = job_ep[j]
-            task = ep_task[e]
-            p = params[task]  # the parameter row, taken once per episode
+            e = jobs.episodes[j]
+            root = jobs.roots[j]
+            task = table.tasks[e]
+            p = table.params[task]  # the parameter row, taken once per episode
             kind = np.int64(p[P_KIND])  # the kernels playing it (the base task of a variant)
             okind = observe_kind(p)  # and observing it
-            env_reset(task, params, ep_start[e], state)
-            env_observe_row(okind, p, state, ep_noise[e, 0], obs)
+            env_reset(task, table.params, table.starts[e], state)
+            env_observe_row(okind, p, state, table.noise[e, 0], obs)
             counts[:] = 0
             total = 0.0
             t = 0
+            if rec is not None:
+                record_state(rec, 0, 0.0, state)
             while True:
-                a_d, a_c = decide(
-                    job_root[j],
-                    W,
-                    team_stamp,
-                    stamp,
-                    bank_stamp,
-                    j,
-                    no_memory,
-                    counts,
-                    team_offsets,
-                    team_members,
-                    prog_offsets,
-                    instrs,
-                    prog_action,
-                    prog_bank,
-                    R,
-                    M,
-                    base,
-                )
+                if rec is not None:
+                    record_observation(rec, t, obs)
+                a_d, a_c = decide(g, buf, root, stamp, j, no_memory, rec)
                 stamp += 1
+                if rec is not None:
+                    record_decision(rec, t, a_d, a_c, buf, g, j)
                 # The one task dispatch, inlined (no call passing the arrays per step).
                 reward, terminated, truncated = task_step(kind, p, state, a_d, a_c)
                 total += reward
                 t += 1
+                if rec is not None:
+                    record_state(rec, t, reward, state)
+                    if t == table.noise.shape[1] - 1:  # a traced row of noise ends the run
+                        break
                 if terminated or truncated:
                     break
-                env_observe_row(okind, p, state, ep_noise[e, t], obs)
-            out_return[j] = total
-            out_steps[j] = t
-            out_teams[j] = counts[0]
-            out_instr[j] = counts[1]
+                env_observe_row(okind, p, state, table.noise[e, t], obs)
+            out.returns[j] = total
+            out.steps[j] = t
+            out.teams[j] = counts[0]
+            out.instructions[j] = counts[1]
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_jobs_parallel(
-    n_workers,
-    next_block,
-    block,
-    job_root,
-    job_ep,
-    ep_task,
-    ep_start,
-    ep_noise,
-    params,
-    no_memory,
-    out_return,
-    out_steps,
-    out_teams,
-    out_instr,
-    team_offsets,
-    team_members,
-    prog_offsets,
-    instrs,
-    prog_action,
-    prog_bank,
-    R,
-    M,
-    base,
-):  # noqa: N803
+def run_jobs_parallel(n_workers, next_block, block, jobs, table, no_memory, out, g):
     """Runs all jobs on ``n_workers`` workers (one per Numba thread) sharing one queue.
 
     ``next_block`` is the queue's counter (int64 ``[1]``, 0 to start); once every job is
@@ -300,27 +288,4 @@ def run_jobs_parallel(
     the queue empty).
     """
     for _ in prange(n_workers):
-        run_jobs_queue(
-            next_block,
-            block,
-            job_root,
-            job_ep,
-            ep_task,
-            ep_start,
-            ep_noise,
-            params,
-            no_memory,
-            out_return,
-            out_steps,
-            out_teams,
-            out_instr,
-            team_offsets,
-            team_members,
-            prog_offsets,
-            instrs,
-            prog_action,
-            prog_bank,
-            R,
-            M,
-            base,
-        )
+        run_jobs_queue(next_block, block, jobs, table, no_memory, out, g)

@@ -42,34 +42,15 @@ from mtpg.export.harness import (
 )
 from mtpg.export.python import write_python
 from mtpg.model.graph import Population
-from mtpg.model.instructions import N_CONSTANTS
 
 #: Seconds one timed run of the C driver or the engine should last at least.
 MIN_RUN_SECONDS = 0.3
 
 
 @njit(cache=True, error_model="numpy")
-def _engine_loop(
-    root,
-    obs,
-    starts,
-    no_memory,
-    repeats,
-    team_offsets,
-    team_members,
-    prog_offsets,
-    instrs,
-    prog_action,
-    prog_bank,
-    R,
-    M,
-    base,
-):  # noqa: N803
+def _engine_loop(g, root, obs, starts, no_memory, repeats):
     """Plays the stream ``repeats`` times with the engine's decision kernel; a checksum."""
-    W, team_stamp, bank_stamp, _state, counts = thread_buffers(  # noqa: N806
-        team_offsets, prog_bank, R, M, base
-    )
-    o = R + N_CONSTANTS
+    buf = thread_buffers(g)
     stamp = 0
     episode = -1
     checksum = 0.0
@@ -77,27 +58,9 @@ def _engine_loop(
         for t in range(obs.shape[0]):
             if starts[t]:
                 episode += 1
-            W[o] = obs[t, 0]
-            W[o + 1] = obs[t, 1]
-            a_d, a_c = decide(
-                root,
-                W,
-                team_stamp,
-                stamp,
-                bank_stamp,
-                episode,
-                no_memory,
-                counts,
-                team_offsets,
-                team_members,
-                prog_offsets,
-                instrs,
-                prog_action,
-                prog_bank,
-                R,
-                M,
-                base,
-            )
+            buf.obs[0] = obs[t, 0]
+            buf.obs[1] = obs[t, 1]
+            a_d, a_c = decide(g, buf, root, stamp, episode, no_memory, None)
             stamp += 1
             checksum += a_d + a_c
     return checksum
@@ -157,16 +120,17 @@ def time_engine(pop: Population, root: int, stream: Stream, no_memory: bool, run
     """Fastest engine run in microseconds per decision, and the stream passes per run."""
     cp = compile_population(pop)
     args = (
+        cp.graph,
         cp.team_index(root),
         np.ascontiguousarray(stream.obs),
         np.ascontiguousarray(stream.starts),
         no_memory,
     )
-    _engine_loop(*args, 1, *cp.kernel_args())  # compile / load from cache
+    _engine_loop(*args, 1)  # compile / load from cache
 
     def once(repeats: int) -> float:
         t0 = time.perf_counter()
-        _engine_loop(*args, repeats, *cp.kernel_args())
+        _engine_loop(*args, repeats)
         return (time.perf_counter() - t0) / (repeats * len(stream.obs))
 
     repeats = _repeats(once(1) * len(stream.obs))

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.ablations import ABLATIONS as ABLATIONS  # re-exported: the table lives there
+from mtpg.envs.reference import give_reference, parse_given
 from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
 from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
 from mtpg.limits import LIMITS
@@ -170,6 +171,12 @@ class EvaluationConfig:
     """Beyond the paper: every this many generations the training episodes are redrawn
     (seeds disjoint from validation and test) and every surviving root is evaluated
     again on them. 0 (the paper): one fixed set, each root evaluated once for life."""
+    references: tuple[str, ...] = ()
+    """Reference scores given for variants among ``tasks``, one entry per variant:
+    ``"TASK: best=NUMBER[, random=NUMBER], source=TEXT"`` (``[[task]]`` tables take
+    ``reference = {best = ..., source = "..."}``). A variant without one is normalised
+    against its base task's best with a measured random score
+    (:func:`mtpg.envs.reference.reference_of`)."""
 
     def __post_init__(self) -> None:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
@@ -201,6 +208,29 @@ class EvaluationConfig:
             minimum=0,
         )
         _positive(self, "evaluation", ("validation_top_k",))
+        self._check_references()
+
+    def _check_references(self) -> None:
+        """Validates ``references`` and gives them to :mod:`mtpg.envs.reference`."""
+        seen = set()
+        for text in self.references:
+            _check(isinstance(text, str), "evaluation.references", "must hold text", text)
+            try:
+                given = parse_given(text)
+            except ValueError as exc:
+                raise ConfigError(f"evaluation.references: {exc}") from None
+            _check(
+                given.task in self.tasks,
+                "evaluation.references",
+                "must name a task of evaluation.tasks",
+                given.task,
+            )
+            _check(given.task not in seen, "evaluation.references", "gives a task twice", text)
+            seen.add(given.task)
+            try:
+                give_reference(given)
+            except ValueError as exc:
+                raise ConfigError(f"evaluation.references: {exc}") from None
 
     @property
     def n_subsets(self) -> int:
@@ -391,12 +421,45 @@ def _task_tables(data: dict[str, Any], toml_file: str | Path) -> dict[str, Any]:
     tables = data.pop("task")
     if "tasks" in data.get("evaluation", {}):
         raise ConfigError(f"{toml_file}: give the tasks as [[task]] or evaluation.tasks, not both")
+    if "references" in data.get("evaluation", {}) and any(
+        isinstance(t, dict) and "reference" in t for t in tables
+    ):
+        raise ConfigError(
+            f"{toml_file}: give reference scores in [[task]] or evaluation.references, not both"
+        )
     try:
-        names = from_tables(tables)
+        references = [
+            reference_entry(t) for t in tables if isinstance(t, dict) and "reference" in t
+        ]
+        names = from_tables(
+            [
+                {k: v for k, v in t.items() if k != "reference"} if isinstance(t, dict) else t
+                for t in tables
+            ]
+        )
     except ValueError as exc:
         raise ConfigError(f"{toml_file}: {exc}") from None
     data["evaluation"] = {**data.get("evaluation", {}), "tasks": names}
+    if references:
+        data["evaluation"]["references"] = references
     return data
+
+
+def reference_entry(table: dict[str, Any]) -> str:
+    """The ``evaluation.references`` entry of a ``[[task]]`` table's ``reference``.
+
+    ``{base = "CartPole", max_steps = 500, reference = {best = 500, source = "..."}}``
+    gives ``"CartPole[max_steps=500]: best=500.0, source=..."``.
+
+    Raises:
+        ValueError: If ``reference`` is not a table of best, source and optionally random.
+    """
+    ref = table["reference"]
+    name = from_tables([{k: v for k, v in table.items() if k != "reference"}])[0]
+    if not isinstance(ref, dict) or set(ref) - {"best", "random", "source"}:
+        raise ValueError(f"{name}: reference must be a table of best, source and random")
+    items = [f"{k}={ref[k]!r}" for k in ("best", "random") if k in ref]
+    return f"{name}: {', '.join(items)}, source={ref.get('source', '')}"
 
 
 def _deep_update(into: dict[str, Any], data: dict[str, Any]) -> None:

@@ -27,5 +27,10 @@ PRESETS: dict[str, dict[str, dict[str, Any] | Any]] = {
 #: of a run's identity so that runs made before they existed keep theirs.
 EXTENSIONS: dict[str, tuple[str, ...]] = {
     "team": ("parent_selection",),
-    "evaluation": ("validation_episodes", "validation_top_k", "resample_interval"),
+    "evaluation": (
+        "validation_episodes",
+        "validation_top_k",
+        "resample_interval",
+        "references",
+    ),
 }

@@ -19,6 +19,8 @@ Conventions (used by the stored figures and by the re-measuring functions):
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from mtpg.envs.core import CARTCENTERING
@@ -29,7 +31,7 @@ from mtpg.envs.protocol import (  # noqa: F401  (the seed bases live in protocol
     held_out_seeds,
 )
 from mtpg.envs.registry import TASKS
-from mtpg.envs.taskspec import Reference
+from mtpg.envs.taskspec import NONE, Reference
 
 #: Seed of the random agent's action generator.
 RANDOM_ACTION_SEED = 12345
@@ -113,17 +115,102 @@ def measure_time_optimal_cartcentering(
 REFERENCE: tuple[Reference, ...] = tuple(t.reference for t in TASKS)
 
 
-_MEASURED: dict[str, Reference] = {}
+_MEASURED: dict[str, tuple[float, float]] = {}
+_GIVEN: dict[str, GivenReference] = {}
+
+
+class GivenReference(NamedTuple):
+    """Reference scores of a variant given by the user, with their source.
+
+    Attributes:
+        task: The variant's canonical name.
+        best: The reference best score (Fig. 6 normalisation).
+        source: Where ``best`` comes from (a paper, a leaderboard, a measurement).
+        random: The random agent's mean score, or None to measure it on demand.
+    """
+
+    task: str
+    best: float
+    source: str
+    random: float | None = None
+
+    def text(self) -> str:
+        """The entry as ``evaluation.references`` holds it (:func:`parse_given`)."""
+        random = "" if self.random is None else f", random={self.random!r}"
+        return f"{self.task}: best={self.best!r}{random}, source={self.source}"
+
+
+def parse_given(text: str) -> GivenReference:
+    """Reads one entry of ``evaluation.references``.
+
+    The entry is ``"TASK: best=NUMBER[, random=NUMBER], source=TEXT"``; ``source`` comes
+    last and takes the rest of the entry (commas included). ``TASK`` must be a variant
+    spelled canonically: a registered task's reference scores are the registry's.
+
+    Raises:
+        ValueError: One line naming the fault.
+    """
+    from mtpg.envs.variants import canonical, is_variant
+
+    task, sep, rest = (s.strip() for s in text.partition(":"))
+    if not sep or not task:
+        raise ValueError(f"{text!r}: write TASK: best=NUMBER[, random=NUMBER], source=TEXT")
+    if not is_variant(task):
+        raise ValueError(f"{task}: a registered task's reference scores are the registry's")
+    if canonical(task) != task:
+        raise ValueError(f"{task}: spell it {canonical(task)!r}")
+    head, sep, source = rest.partition("source=")
+    if not sep or not source.strip():
+        raise ValueError(f"{task}: needs source=TEXT (where the best score comes from), last")
+    values: dict[str, float] = {}
+    for item in filter(None, (i.strip() for i in head.split(","))):
+        key, eq, raw = (s.strip() for s in item.partition("="))
+        if key not in ("best", "random") or not eq:
+            raise ValueError(f"{task}: unknown setting {item!r}; allowed: best, random, source")
+        if key in values:
+            raise ValueError(f"{task}: {key} given twice")
+        try:
+            values[key] = float(raw)
+        except ValueError:
+            raise ValueError(f"{task}: {key}: {raw!r} is not a number") from None
+        if not np.isfinite(values[key]):
+            raise ValueError(f"{task}: {key}: must be finite, got {raw!r}")
+    if "best" not in values:
+        raise ValueError(f"{task}: needs best=NUMBER")
+    if values["best"] == values.get("random"):
+        raise ValueError(f"{task}: best equals random; nothing could be normalised")
+    return GivenReference(task, values["best"], source.strip(), values.get("random"))
+
+
+def give_reference(given: GivenReference) -> None:
+    """Uses ``given`` as the reference scores of its variant in this process.
+
+    Like variant ids, given references are process-wide, by task name: every run of the
+    variant analysed in the process is normalised by them. Giving the same entry again is
+    harmless; a different one for the same variant is refused, so two runs never mix.
+
+    Raises:
+        ValueError: If the variant already has different given reference scores.
+    """
+    held = _GIVEN.get(given.task)
+    if held is not None and held != given:
+        raise ValueError(
+            f"{given.task}: reference scores already given differently in this process "
+            f"({held.text()!r})"
+        )
+    _GIVEN[given.task] = given
 
 
 def reference_of(task: int | str) -> Reference:
     """The reference scores of a task or variant.
 
-    A registered task's are its spec's. A variant's are measured on first use in the
-    process and kept: ``random`` / ``random_std`` by :func:`measure_random` on the variant
-    itself (its own dynamics and time limit), and ``best`` the base task's reference best,
-    with the source saying so (the variant's own best is not known; a changed time limit
-    may allow more).
+    A registered task's are its spec's. A variant's ``best`` is the one given by the user
+    (:func:`give_reference`, ``evaluation.references``) with its source, or else the base
+    task's reference best, with the source saying so (the variant's own best is not
+    known; a changed time limit may allow more). Its ``random`` / ``random_std`` are the
+    given ``random`` (standard deviation unknown: NaN) or else measured by
+    :func:`measure_random` on the variant itself (its own dynamics and time limit) on
+    first use in the process, and kept.
 
     Args:
         task: A task id or name.
@@ -133,17 +220,18 @@ def reference_of(task: int | str) -> Reference:
     spec = spec_of(resolve(task) if isinstance(task, str) else int(task))
     if not spec.base:
         return spec.reference
-    if spec.name not in _MEASURED:
-        mean, std = measure_random(resolve(spec.name))
-        base = spec_of(spec.base).reference
-        _MEASURED[spec.name] = Reference(
-            mean,
-            std,
-            base.best,
-            base.solved,
-            f"random measured; best of {spec.base}: {base.source}",
-        )
-    return _MEASURED[spec.name]
+    given = _GIVEN.get(spec.name)
+    if given is not None and given.random is not None:
+        random = (given.random, NONE)
+    else:
+        if spec.name not in _MEASURED:
+            _MEASURED[spec.name] = measure_random(resolve(spec.name))
+        random = _MEASURED[spec.name]
+    how = "random given" if given is not None and given.random is not None else "random measured"
+    if given is not None:
+        return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")
+    base = spec_of(spec.base).reference
+    return Reference(*random, base.best, base.solved, f"{how}; best of {spec.base}: {base.source}")
 
 
 def normalise(

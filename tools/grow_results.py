@@ -143,7 +143,7 @@ def start(name: str, seed: int, ablation: str | None, args: argparse.Namespace) 
         flag = [f"--{ablation}"] if ablation else []
         cmd = ["train", "--preset", "paper", "--seed", str(seed), *flag, *common]
         cmd += [*args.train_arg, "--out", str(path)]
-    log = open(args.results / "runs" / f"{name}.log", "a")  # noqa: SIM115 - the child's
+    log = open(args.results / "runs" / f"{name}.log", "a")
     proc = subprocess.Popen(
         [args.python, "-m", "mtpg", *cmd],
         stdout=log,

@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from grow_results import KEEP_TESTS_EVERY  # noqa: E402
-from results_text import (  # noqa: E402 - the tool's own helper module beside it
+from grow_results import KEEP_TESTS_EVERY
+from results_text import (  # the tool's own helper module beside it
     PAPER,
     ablation_rows,
     compare_table,

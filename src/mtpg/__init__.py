@@ -2,4 +2,4 @@
 
 __version__ = "0.1.0"
 
-import mtpg.envs  # noqa: E402, F401  (registers the Gymnasium ids mtpg/<Task>-v0; numba loads lazily)
+import mtpg.envs  # noqa: F401  (registers the Gymnasium ids mtpg/<Task>-v0; numba loads lazily)

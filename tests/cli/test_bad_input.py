@@ -268,7 +268,7 @@ class _Holder:
     value = None
 
 
-class _nothing:  # noqa: N801 - a context manager standing in for pytest.raises
+class _nothing:  # a context manager standing in for pytest.raises
     def __enter__(self):
         return _Holder()
 

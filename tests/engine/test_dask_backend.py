@@ -8,13 +8,13 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from mtpg.config import build_config  # noqa: E402
-from mtpg.engine.batch import Episodes, evaluate_roots  # noqa: E402
-from mtpg.engine.compile import compile_population  # noqa: E402
-from mtpg.engine.dask_backend import DaskEvaluator, plan_batches  # noqa: E402
-from mtpg.engine.workload import tangled_population  # noqa: E402
-from mtpg.envs.variants import resolve  # noqa: E402
-from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer  # noqa: E402
+from mtpg.config import build_config
+from mtpg.engine.batch import Episodes, evaluate_roots
+from mtpg.engine.compile import compile_population
+from mtpg.engine.dask_backend import DaskEvaluator, plan_batches
+from mtpg.engine.workload import tangled_population
+from mtpg.envs.variants import resolve
+from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
 
 TINY = [
     "team.root_size=30",

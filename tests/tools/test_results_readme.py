@@ -10,7 +10,7 @@ from stopruns import mtpg
 from tinyruns import tiny_args
 
 sys.path.insert(0, str(Path(__file__).parents[2] / "tools"))
-import results_readme  # noqa: E402
+import results_readme
 
 
 @pytest.fixture(scope="module")

@@ -255,7 +255,7 @@ class DaskEvaluator:
             try:
                 parts = self._map(cp, roots, episodes, no_memory)
                 break
-            except Exception as exc:  # noqa: BLE001 - a cluster failure: retry, else local
+            except Exception as exc:  # a cluster failure: retry, else local
                 if not _is_cluster_failure(exc):
                     raise
                 if attempt < RESUBMITS and self.client.status == "running":
@@ -329,7 +329,7 @@ class DaskEvaluator:
             if thing is not None:
                 try:
                     thing.close()
-                except Exception as exc:  # noqa: BLE001 - closing a dead cluster
+                except Exception as exc:  # closing a dead cluster
                     print(f"closing the dask cluster: {exc}", file=sys.stderr)
         self.cluster = None
         _restore_log_levels(self._log_levels)

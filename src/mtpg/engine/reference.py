@@ -19,7 +19,7 @@ from mtpg.model.instructions import BIG, CONSTANTS, DIV_EPS, LOG_BIG, LOG_TINY
 _CONST = [float(c) for c in CONSTANTS]
 
 
-def reference_op(op: int, d: float, a: float, b: float) -> float:  # noqa: C901
+def reference_op(op: int, d: float, a: float, b: float) -> float:
     """The protected operation table of :mod:`mtpg.model.instructions` in plain Python."""
     if op == 0:
         v = a + b
@@ -173,7 +173,7 @@ def reference_episode(
     from mtpg.envs.core import STATE_SIZE
     from mtpg.envs.variants import task_params
 
-    TASK_PARAMS = task_params()  # noqa: N806  (variants' rows included)
+    TASK_PARAMS = task_params()  # variants' rows included
 
     agent.reset()
     state = np.zeros(STATE_SIZE)

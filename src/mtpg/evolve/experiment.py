@@ -114,7 +114,7 @@ def execute(
                 run = todo.pop(0)
                 log(f"{run.path.name}: {run.state(generations)} -> starting")
                 run.path.parent.mkdir(parents=True, exist_ok=True)
-                logfile = open(run.path.parent / f"{run.path.name}.log", "a")  # noqa: SIM115
+                logfile = open(run.path.parent / f"{run.path.name}.log", "a")
                 running.append(
                     (
                         run,

@@ -19,7 +19,7 @@ from types import FrameType
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)
 
 
-class StopNow(KeyboardInterrupt):  # noqa: N818 - a request, like KeyboardInterrupt
+class StopNow(KeyboardInterrupt):  # a request, like KeyboardInterrupt
     """Raised by a second stop signal: stop at once, abandoning the generation under way."""
 
     def __init__(self, signum: int) -> None:

@@ -12,8 +12,8 @@ from mtpg.cli.main import main
 from mtpg.evolve.trainer import TIMING_COLUMNS
 from tinyruns import tiny_args
 
-TASKS = "CartPole[max_steps=500],Pendulum[observe=theta;max_steps=60]"
-CANONICAL = ["CartPole[max_steps=500]", "Pendulum[max_steps=60;observe=theta]"]
+TASKS = "CartPole[max_steps=500],Pendulum[observe=theta;max_steps=60;noise=0.1]"
+CANONICAL = ["CartPole[max_steps=500]", "Pendulum[max_steps=60;noise=0.1;observe=theta]"]
 TINY = tiny_args(TASKS, root_size=16, n_elite=2, evaluation__test_interval=2)
 
 

@@ -113,7 +113,7 @@ def test_an_id_without_a_branch_is_loud(graph):
     cp = compile_population(pop)
     table = Episodes(
         np.array([missing]), np.zeros(1, np.int64), np.zeros((1, STATE_SIZE)), np.zeros((1, 201)),
-        params,
+        np.zeros((1, 0, 2)), params,
     )  # fmt: skip
     jobs = Jobs(np.array([cp.team_index(root)]), np.zeros(1, np.int64))
     out = BatchResult.zeros(1)

@@ -131,7 +131,9 @@ def test_observe_variant_scales_the_chosen_state_variables() -> None:
 
 
 @pytest.mark.filterwarnings("ignore:.*Box action space.*:UserWarning")
-@pytest.mark.parametrize("name", [CP500, "Pendulum[observe=theta_dot;max_steps=50]"])
+@pytest.mark.parametrize(
+    "name", [CP500, "Pendulum[observe=theta_dot;max_steps=50]", "Pendulum[noise=0.2;observe=theta]"]
+)
 def test_variant_environments_pass_check_env(name: str) -> None:
     for action in ("paper", "native"):
         env = gymnasium.make(register(name), action=action)
@@ -139,7 +141,15 @@ def test_variant_environments_pass_check_env(name: str) -> None:
         env.close()
 
 
-@pytest.mark.parametrize("name", [CP500, "MountainCar[observe=velocity;max_steps=80]"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        CP500,
+        "MountainCar[observe=velocity;max_steps=80]",
+        "CartPole[noise=0.3]",
+        "Pendulum[max_steps=80;noise=0.1;observe=theta]",
+    ],
+)
 def test_engine_plays_a_variant_like_the_reference_interpreter(name: str) -> None:
     task = resolve(name)
     pop = tangled_population(np.random.default_rng(3), 6, 20, 12, 4, 0.5)
@@ -147,11 +157,15 @@ def test_engine_plays_a_variant_like_the_reference_interpreter(name: str) -> Non
     episodes = Episodes.grid([task], [0, 1])
     cp = compile_population(pop)
     returns, result = evaluate_roots(cp, roots, episodes)
+    eps = episodes.obs_noise if episodes.obs_noise.shape[1] else [None, None]
+    assert ("noise=" in name) == (episodes.obs_noise.shape[1] > 0)
     for i, root in enumerate(roots):
         for e in range(2):
             total, steps = reference_episode(
-                ReferenceAgent(pop, root), task, episodes.starts[e], episodes.noise[e]
+                ReferenceAgent(pop, root), task, episodes.starts[e], episodes.noise[e], eps[e]
             )
             assert returns[i, e] == total and result.steps[i * 2 + e] == steps
-            trace = trace_episode(cp, root, task, episodes.starts[e], episodes.noise[e])
+            trace = trace_episode(
+                cp, root, task, episodes.starts[e], episodes.noise[e], obs_noise=eps[e]
+            )
             assert len(trace.actions) == steps <= spec_of(task).max_steps

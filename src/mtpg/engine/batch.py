@@ -13,7 +13,7 @@ import numpy as np
 
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.kernels import run_jobs_parallel, run_jobs_queue
-from mtpg.envs import make_episodes
+from mtpg.envs.episodes import draw_episodes
 from mtpg.envs.variants import task_params
 
 
@@ -25,6 +25,8 @@ class Episodes(NamedTuple):
         seeds: int64 ``[n]`` episode seeds.
         starts: float64 ``[n, STATE_SIZE]``.
         noise: float64 ``[n, T + 1]``.
+        obs_noise: float64 ``[n, T + 1, 2]``: the observation noise of variants with
+            ``noise`` (:func:`mtpg.envs.episodes.draw_episodes`), or ``[n, 0, 2]``.
         params: float64 ``[ids, N_PARAMS]``: the parameter table the task ids index
             (``mtpg.envs.variants.task_params()`` when the table was drawn).
     """
@@ -33,6 +35,7 @@ class Episodes(NamedTuple):
     seeds: np.ndarray
     starts: np.ndarray
     noise: np.ndarray
+    obs_noise: np.ndarray
     params: np.ndarray
 
     @classmethod
@@ -40,19 +43,24 @@ class Episodes(NamedTuple):
         """Draws the episodes with the given task ids and seeds (equal lengths)."""
         tasks = np.asarray(tasks, dtype=np.int64)
         seeds = np.asarray(seeds, dtype=np.int64)
-        starts, noise = make_episodes(tasks, seeds)
-        return cls(
-            tasks, seeds, np.ascontiguousarray(starts), np.ascontiguousarray(noise), task_params()
-        )
+        starts, noise, obs_noise = draw_episodes(tasks, seeds)
+        return cls(tasks, seeds, starts, noise, obs_noise, task_params())
 
     @classmethod
-    def single(cls, task: int, start: np.ndarray, noise: np.ndarray) -> Episodes:
-        """A table of one given episode: ``task`` from ``start`` with the ``noise`` row."""
+    def single(
+        cls, task: int, start: np.ndarray, noise: np.ndarray, obs_noise: np.ndarray | None = None
+    ) -> Episodes:
+        """A table of one given episode: ``task`` from ``start`` with the ``noise`` row.
+
+        ``obs_noise``: the rows ``[T + 1, 2]`` of a variant with observation noise.
+        """
+        eps = np.zeros((0, 2)) if obs_noise is None else obs_noise
         return cls(
             np.array([task], dtype=np.int64),
             np.zeros(1, dtype=np.int64),
             np.ascontiguousarray(start, dtype=np.float64).reshape(1, -1),
             np.ascontiguousarray(noise, dtype=np.float64).reshape(1, -1),
+            np.ascontiguousarray(eps, dtype=np.float64).reshape(1, -1, 2),
             task_params(),
         )
 

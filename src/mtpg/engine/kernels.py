@@ -37,8 +37,14 @@ from mtpg.engine.record import (
     record_team,
 )
 from mtpg.envs.core import STATE_SIZE
-from mtpg.envs.kernels import env_observe_row, env_reset, observe_kind, task_step
-from mtpg.envs.tasks import P_KIND
+from mtpg.envs.kernels import (
+    add_obs_noise,
+    env_observe_row,
+    env_reset,
+    observe_kind,
+    task_step,
+)
+from mtpg.envs.tasks import P_KIND, P_OBS_SD
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
 _CONSTANTS = CONSTANTS.copy()
@@ -249,7 +255,10 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
             kind = np.int64(p[P_KIND])  # the kernels playing it (the base task of a variant)
             okind = observe_kind(p)  # and observing it
             env_reset(task, table.params, table.starts[e], state)
+            noisy = p[P_OBS_SD] != 0.0  # a variant with observation noise
             env_observe_row(okind, p, state, table.noise[e, 0], obs)
+            if noisy:
+                add_obs_noise(p, table.obs_noise[e, 0, 0], table.obs_noise[e, 0, 1], obs)
             counts[:] = 0
             total = 0.0
             t = 0
@@ -273,6 +282,8 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
                 if terminated or truncated:
                     break
                 env_observe_row(okind, p, state, table.noise[e, t], obs)
+                if noisy:
+                    add_obs_noise(p, table.obs_noise[e, t, 0], table.obs_noise[e, t, 1], obs)
             out.returns[j] = total
             out.steps[j] = t
             out.teams[j] = counts[0]

@@ -156,7 +156,11 @@ class ReferenceAgent:
 
 
 def reference_episode(
-    agent: ReferenceAgent, task: int, start: np.ndarray, noise: np.ndarray
+    agent: ReferenceAgent,
+    task: int,
+    start: np.ndarray,
+    noise: np.ndarray,
+    obs_noise: np.ndarray | None = None,
 ) -> tuple[float, int]:
     """Plays one episode with the environment kernels called from Python.
 
@@ -165,6 +169,8 @@ def reference_episode(
         task: Task id.
         start: Start state (``STATE_SIZE``).
         noise: The episode's noise row.
+        obs_noise: The episode's observation-noise rows ``[T + 1, 2]`` (a variant with
+            ``noise``), or None.
 
     Returns:
         ``(return, steps)``.
@@ -179,7 +185,8 @@ def reference_episode(
     state = np.zeros(STATE_SIZE)
     obs = np.zeros(2)
     env_reset(task, TASK_PARAMS, start, state)
-    env_observe(task, TASK_PARAMS, state, noise[0], obs)
+    eps = obs_noise if obs_noise is not None and len(obs_noise) else None
+    env_observe(task, TASK_PARAMS, state, noise[0], obs, None if eps is None else eps[0])
     total, t = 0.0, 0
     while True:
         d = agent.act(obs)
@@ -188,4 +195,4 @@ def reference_episode(
         t += 1
         if terminated or truncated:
             return total, t
-        env_observe(task, TASK_PARAMS, state, noise[t], obs)
+        env_observe(task, TASK_PARAMS, state, noise[t], obs, None if eps is None else eps[t])

@@ -149,10 +149,14 @@ def trace_episode(
     noise: np.ndarray,
     no_memory: bool = False,
     snapshot: bool = False,
+    obs_noise: np.ndarray | None = None,
 ) -> Trace:
-    """Traces one episode of ``task`` from ``start`` with the episode's ``noise`` row."""
+    """Traces one episode of ``task`` from ``start`` with the episode's ``noise`` row.
+
+    ``obs_noise``: the episode's rows ``[T + 1, 2]``, for a variant with observation noise.
+    """
     root = cp.team_index(root_id)
-    table = Episodes.single(task, start, noise)
+    table = Episodes.single(task, start, noise, obs_noise)
     jobs = Jobs(np.array([root], dtype=np.int64), np.zeros(1, dtype=np.int64))
     out = BatchResult.zeros(1)
 

@@ -43,6 +43,9 @@ def sample_start(task: int, rng: np.random.Generator) -> np.ndarray:
 def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Draws the start states and noise sequences of a batch of episodes.
 
+    The start states and U[0, 1] sequences of :func:`draw_episodes` (without the
+    observation noise of variants that have it).
+
     For episode ``i``: ``rng = np.random.default_rng(seeds[i])``, the start state is
     ``sample_start(tasks[i], rng)``, then ``MAX_STEPS[tasks[i]] + 1`` noise values are drawn
     with ``rng.random``. ``noise[i, 0]`` is observed at reset and ``noise[i, t + 1]`` after
@@ -58,6 +61,30 @@ def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.
     Raises:
         ValueError: If the arrays differ in length or a task id is unknown.
     """
+    starts, noise, _ = draw_episodes(tasks, seeds)
+    return starts, noise
+
+
+def draw_episodes(
+    tasks: np.ndarray, seeds: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Draws the start states, noise sequences and observation noise of a batch of episodes.
+
+    As :func:`make_episodes`; then, for an episode of a variant with observation noise
+    (``noise=SD``), the same generator draws ``standard_normal((MAX_STEPS + 1, 2))``: the
+    two inputs' normal values of each observation, ``obs_noise[i, t]`` read with
+    ``noise[i, t]``. Episodes of other tasks draw nothing more, so their streams are those
+    of :func:`make_episodes` alone.
+
+    Returns:
+        (starts, noise, obs_noise): ``obs_noise`` float64 ``[n, width, 2]`` (zeros for
+        episodes without observation noise), or ``[n, 0, 2]`` when no episode has any.
+
+    Raises:
+        ValueError: If the arrays differ in length or a task id is unknown.
+    """
+    from mtpg.envs.variants import obs_noise_sd
+
     tasks = np.asarray(tasks).reshape(-1)
     seeds = np.asarray(seeds).reshape(-1)
     if tasks.shape != seeds.shape:
@@ -67,12 +94,16 @@ def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.
         _check_task(task)
     limits = {int(t): spec_of(int(t)).max_steps for t in set(tasks.tolist())}
     width = max(limits.values()) + 1 if n else 1
+    noisy = {t for t in limits if obs_noise_sd(spec_of(t)) > 0.0}
     starts = np.zeros((n, STATE_SIZE), dtype=np.float64)
     noise = np.zeros((n, width), dtype=np.float64)
+    obs_noise = np.zeros((n, width if noisy else 0, 2), dtype=np.float64)
     for i in range(n):
         task = _check_task(tasks[i])
         rng = np.random.default_rng(int(seeds[i]))
         starts[i] = sample_start(task, rng)
         k = limits[task] + 1
         noise[i, :k] = rng.random(k)
-    return starts, noise
+        if task in noisy:
+            obs_noise[i, :k] = rng.standard_normal((k, 2))
+    return starts, noise, obs_noise

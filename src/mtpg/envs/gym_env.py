@@ -6,7 +6,9 @@ the task's own single action instead of the paper's pair, for libraries that tra
 ``Discrete`` or ``Box`` action. The environment uses exactly the kernels of the execution
 engine and the episode draws of ``make_episodes``: ``reset(seed=s)`` seeds the generator
 ``np.random.default_rng(s)`` (Gymnasium's ``np_random``), draws the start state with
-``sample_start`` and then one noise value per observation.
+``sample_start`` and then one noise value per observation. A variant with observation
+noise draws the episode's noise values and normal values at reset instead, in the order of
+``draw_episodes``, so it plays the episode the engine plays.
 
 ``info["state"]`` holds the full hidden state in Gymnasium's order. It is for analysis
 only and must never be fed to an agent.
@@ -20,10 +22,10 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from mtpg.envs.core import N_OBS, STATE_SIZE
+from mtpg.envs.core import N_OBS, STATE_SIZE, STEP_SLOT
 from mtpg.envs.episodes import sample_start
 from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.variants import resolve, spec_of, task_params, valid_id
+from mtpg.envs.variants import obs_noise_sd, resolve, spec_of, task_params, valid_id
 
 #: The action interfaces: the paper's pair, or the task's own single action.
 ACTIONS: tuple[str, ...] = ("paper", "native")
@@ -98,10 +100,17 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         self._continuous = spec_of(self._task).continuous
         self._last_action = 0.0
         self._renderer: Any = None
+        self._noisy = obs_noise_sd(spec_of(self._task)) > 0.0
+        self._drawn: tuple[np.ndarray, np.ndarray] | None = None  # (noise, obs_noise)
 
     def _observe(self) -> np.ndarray:
-        noise = float(self.np_random.random())
-        env_observe(self._task, self._params, self._state, noise, self._obs)
+        if self._drawn is None:
+            noise = float(self.np_random.random())
+            env_observe(self._task, self._params, self._state, noise, self._obs)
+        else:
+            t = min(int(self._state[STEP_SLOT]), len(self._drawn[0]) - 1)
+            u, eps = self._drawn
+            env_observe(self._task, self._params, self._state, u[t], self._obs, eps[t])
         return self._obs.copy()
 
     def _info(self) -> dict[str, Any]:
@@ -121,6 +130,9 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         """
         super().reset(seed=seed)
         start = sample_start(self._task, self.np_random)
+        if self._noisy:
+            k = spec_of(self._task).max_steps + 1
+            self._drawn = (self.np_random.random(k), self.np_random.standard_normal((k, 2)))
         env_reset(self._task, self._params, start, self._state)
         self._last_action = 0.0
         return self._observe(), self._info()

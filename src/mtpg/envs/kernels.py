@@ -44,6 +44,8 @@ from mtpg.envs.tasks import (
     P_OBS,
     P_OBS_HI,
     P_OBS_LO,
+    P_OBS_NOISY,
+    P_OBS_SD,
     P_OBS_SLOT,
     P_OBS_WRAP,
 )
@@ -67,7 +69,12 @@ def env_reset(task: int, params: np.ndarray, start: np.ndarray, state: np.ndarra
 
 @njit(cache=True, error_model="numpy")
 def env_observe(
-    task: int, params: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
+    task: int,
+    params: np.ndarray,
+    state: np.ndarray,
+    noise: float,
+    obs: np.ndarray,
+    eps: np.ndarray | None = None,
 ) -> None:
     """Writes the two observed inputs, each in [-1, 1].
 
@@ -77,9 +84,34 @@ def env_observe(
         state: The current state array.
         noise: The episode's U[0, 1] noise value for this step (used by one-input tasks).
         obs: Output array of at least two slots.
+        eps: The episode's two standard normal values for this step (the observation
+            noise of a variant with ``noise``); None when the table has none.
     """
     p = params[task]
     env_observe_row(observe_kind(p), p, state, noise, obs)
+    if eps is not None and p[P_OBS_SD] != 0.0:
+        add_obs_noise(p, eps[0], eps[1], obs)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def add_obs_noise(p: np.ndarray, eps0: float, eps1: float, obs: np.ndarray) -> None:
+    """Adds a variant's Gaussian observation noise to the inputs that observe the state.
+
+    Each such input becomes ``clip(obs + sd * eps)`` (``sd = p[P_OBS_SD]``, in the
+    inputs' [-1, 1] units); the U[0, 1] noise input of a one-input task is left as it is.
+
+    Args:
+        p: The parameter row.
+        eps0: Standard normal value of the first input.
+        eps1: Standard normal value of the second input.
+        obs: The observation, updated in place.
+    """
+    sd = p[P_OBS_SD]
+    n = np.int64(p[P_OBS_NOISY])
+    if n > 0:
+        obs[0] = clip_obs(obs[0] + sd * eps0)
+    if n > 1:
+        obs[1] = clip_obs(obs[1] + sd * eps1)
 
 
 #: The observation kind of a row whose ``P_OBS`` column is set (a variant's observation).

@@ -44,8 +44,14 @@ P_OBS_HI = N_TASK_COLUMNS + 6
 #: Two columns: 1 when the observed slot is an angle wrapped into [-pi, pi) first.
 P_OBS_WRAP = N_TASK_COLUMNS + 8
 
+#: The standard deviation of the Gaussian observation noise added to the inputs that
+#: observe the state (0: none), in the inputs' [-1, 1] units.
+P_OBS_SD = N_TASK_COLUMNS + 10
+#: How many leading inputs observe the state (the others are the U[0, 1] noise input).
+P_OBS_NOISY = N_TASK_COLUMNS + 11
+
 #: Number of columns of ``TASK_PARAMS``.
-N_PARAMS = N_TASK_COLUMNS + 10
+N_PARAMS = N_TASK_COLUMNS + 12
 #: Number of tasks.
 N_TASKS = len(TASKS)
 
@@ -54,6 +60,8 @@ def param_row(
     params: tuple[float, ...],
     kind: int,
     observe: tuple[tuple[int, float, float, bool], ...] | None = None,
+    obs_sd: float = 0.0,
+    noisy_inputs: int = 0,
 ) -> np.ndarray:
     """One row of the parameter table: the task's columns, then the interface columns.
 
@@ -62,6 +70,8 @@ def param_row(
         kind: The id of the task whose kernels play the row.
         observe: None for the task's own observation, else up to two
             ``(slot, low, high, wrap)`` inputs (a missing second input is noise).
+        obs_sd: Standard deviation of the Gaussian observation noise (0: none).
+        noisy_inputs: How many leading inputs observe the state (and get that noise).
 
     Returns:
         float64 ``[N_PARAMS]``; unused task columns are 0.
@@ -77,6 +87,8 @@ def param_row(
             row[P_OBS_LO + i] = lo
             row[P_OBS_HI + i] = hi
             row[P_OBS_WRAP + i] = float(wrap)
+    row[P_OBS_SD] = obs_sd
+    row[P_OBS_NOISY] = noisy_inputs
     return row
 
 

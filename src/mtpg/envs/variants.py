@@ -8,7 +8,11 @@ A variant is a registered task with some of its settings changed, written
 - ``observe``: the one or two state variables the two inputs observe, joined by ``+``
   (``observe=x+theta``), each scaled from the base spec's ``state_low..state_high`` to
   [-1, 1] (angles wrapped into [-pi, pi) first) and clipped; with one variable the second
-  input is the U[0, 1] noise input, as in the paper's one-observable tasks.
+  input is the U[0, 1] noise input, as in the paper's one-observable tasks;
+- ``noise``: Gaussian observation noise: each input that observes the state gets
+  ``sd * N(0, 1)`` added (in its [-1, 1] units) and is clipped again; ``sd >= 0``. The
+  normal values are drawn per episode after its start state and U[0, 1] values
+  (:func:`mtpg.envs.episodes.draw_episodes`), so a task without noise draws as before.
 
 The dynamics are the base task's kernels on the variant's parameter row, so a variant
 reproduces its base task step for step and runs in the compiled engine like it. The start
@@ -58,7 +62,7 @@ def _fail(text: str, message: str) -> ValueError:
 
 def allowed_keys(base: TaskSpec) -> tuple[str, ...]:
     """The keys a variant of ``base`` may set."""
-    return (*base.param_names, "observe")
+    return (*base.param_names, "noise", "observe")
 
 
 def _value(text: str, base: TaskSpec, key: str, raw: str) -> str:
@@ -79,6 +83,8 @@ def _value(text: str, base: TaskSpec, key: str, raw: str) -> str:
         raise _fail(text, f"{key}: {raw!r} is not a number") from None
     if not math.isfinite(number):
         raise _fail(text, f"{key}: must be finite, got {raw!r}")
+    if key == "noise" and number < 0:
+        raise _fail(text, f"noise: a standard deviation >= 0, got {raw!r}")
     if key == "max_steps":
         if number != int(number) or number < 1:
             raise _fail(text, f"max_steps: a whole number >= 1, got {raw!r}")
@@ -201,7 +207,7 @@ def variant_spec(name: str) -> TaskSpec:
     base, settings = parse(name)
     params = list(base.params)
     for key, value in settings.items():
-        if key != "observe":
+        if key not in ("observe", "noise"):
             params[base.param_names.index(key)] = float(value)
     spec = replace(
         base,
@@ -215,7 +221,14 @@ def variant_spec(name: str) -> TaskSpec:
         slots = tuple(base.state_names.index(v) for v in observed)
         text = ", ".join(f"{v} scaled" for v in observed) + (", noise" if len(slots) == 1 else "")
         spec = replace(spec, observed_slots=slots, observed=text)
+    if float(settings.get("noise", 0.0)) > 0.0:
+        spec = replace(spec, observed=f"{spec.observed}; observation noise sd {settings['noise']}")
     return spec
+
+
+def obs_noise_sd(spec: TaskSpec) -> float:
+    """The standard deviation of a task's observation noise (0 for none)."""
+    return float(parse(spec.name)[1].get("noise", 0.0)) if spec.base else 0.0
 
 
 def _observe_columns(spec: TaskSpec) -> tuple[tuple[int, float, float, bool], ...] | None:
@@ -241,7 +254,15 @@ def resolve(name: str) -> int:
 
         spec = variant_spec(key)
         _VARIANTS.append(spec)
-        _TABLE.append(param_row(spec.params, TASK_NAMES.index(spec.base), _observe_columns(spec)))
+        _TABLE.append(
+            param_row(
+                spec.params,
+                TASK_NAMES.index(spec.base),
+                _observe_columns(spec),
+                obs_noise_sd(spec),
+                len(spec.observed_slots),
+            )
+        )
         _IDS[key] = VARIANT_ID_BASE + len(_VARIANTS) - 1
     _IDS[name] = _IDS[key]
     return _IDS[key]

@@ -174,10 +174,14 @@ def engine_stream(
     obs_rows, starts, actions, teams = [], [], [], []
     o = np.zeros(2)
     for e, task in enumerate(table.tasks.tolist()):
-        tr = trace_episode(cp, root, task, table.starts[e], table.noise[e], no_memory=no_memory)
+        eps = table.obs_noise[e] if table.obs_noise.shape[1] else None
+        tr = trace_episode(
+            cp, root, task, table.starts[e], table.noise[e], no_memory=no_memory, obs_noise=eps
+        )
         n = len(tr.actions)
         for t in range(n):
-            env_observe(task, table.params, tr.states[t], table.noise[e, t], o)
+            e_t = None if eps is None else eps[t]
+            env_observe(task, table.params, tr.states[t], table.noise[e, t], o, e_t)
             obs_rows.append(o.copy())
         starts.extend([True] + [False] * (n - 1))
         actions.append(tr.actions)

@@ -59,7 +59,7 @@ import numpy as np
 from mtpg.analysis.description.numbering import effective_instruction_map, index_graph
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
-from mtpg.envs import make_episodes
+from mtpg.envs.episodes import draw_episodes
 from mtpg.envs.protocol import held_out_seeds
 from mtpg.envs.variants import canonical, known, resolve
 from mtpg.model.graph import Population
@@ -169,11 +169,18 @@ def replay_task(
     task_id = resolve(task)
     cp = compile_population(pop)
     seeds = held_out_seeds(episodes, seed)
-    starts, noise = make_episodes(np.full(episodes, task_id), seeds)
+    starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds)
     n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
     traces = [
         trace_episode(
-            cp, root, task_id, starts[e], noise[e], no_memory=no_memory, snapshot=e < n_mem_eps
+            cp,
+            root,
+            task_id,
+            starts[e],
+            noise[e],
+            no_memory=no_memory,
+            snapshot=e < n_mem_eps,
+            obs_noise=obs_noise[e] if obs_noise.shape[1] else None,
         )
         for e in range(episodes)
     ]

@@ -39,9 +39,9 @@ from mtpg.engine.record import (
 from mtpg.envs.core import STATE_SIZE
 from mtpg.envs.kernels import (
     add_obs_noise,
-    env_observe_row,
     env_reset,
     observe_kind,
+    task_observe,
     task_step,
 )
 from mtpg.envs.tasks import P_KIND, P_OBS_SD
@@ -256,7 +256,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
             okind = observe_kind(p)  # and observing it
             env_reset(task, table.params, table.starts[e], state)
             noisy = p[P_OBS_SD] != 0.0  # a variant with observation noise
-            env_observe_row(okind, p, state, table.noise[e, 0], obs)
+            task_observe(okind, p, state, table.noise[e, 0], obs)
             if noisy:
                 add_obs_noise(p, table.obs_noise[e, 0, 0], table.obs_noise[e, 0, 1], obs)
             counts[:] = 0
@@ -271,7 +271,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
                 stamp += 1
                 if rec is not None:
                     record_decision(rec, t, a_d, a_c, buf, g, j)
-                # The one task dispatch, inlined (no call passing the arrays per step).
+                # The one task dispatch: a step kernel, called without reference counts.
                 reward, terminated, truncated = task_step(kind, p, state, a_d, a_c)
                 total += reward
                 t += 1
@@ -281,7 +281,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
                         break
                 if terminated or truncated:
                     break
-                env_observe_row(okind, p, state, table.noise[e, t], obs)
+                task_observe(okind, p, state, table.noise[e, t], obs)
                 if noisy:
                     add_obs_noise(p, table.obs_noise[e, t, 0], table.obs_noise[e, t, 1], obs)
             out.returns[j] = total

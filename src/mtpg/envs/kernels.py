@@ -14,6 +14,12 @@ kernels on its own parameter row; a row whose ``P_OBS`` column is set is observe
 ``mtpg.envs.core``); parameters are rows of ``TASK_PARAMS`` (see ``mtpg.envs.tasks``) or of
 ``mtpg.envs.variants.task_params()``.
 
+The dispatch and everything it reaches are compiled without reference counting
+(:data:`step_kernel`): they take arrays and allocate none, while a function compiled with
+Numba's reference counting pays an atomic increment and decrement per array argument and
+call (an IR-inlined one, ``inline="always"``, pays them in its caller): about ten per step
+of the batch kernel, measured in docs/engine.md.
+
 Action conventions: a non-finite ``a_c`` is treated as 0 and then clipped to the task's
 bound; an ``a_d`` outside {0, 1, 2} is treated as 1 ("repeat the previous force" in
 CartPole and CartCentering, "no push" in MountainCar).
@@ -49,6 +55,15 @@ from mtpg.envs.tasks import (
     P_OBS_SLOT,
     P_OBS_WRAP,
 )
+
+#: Options of the step and observation dispatch, which take arrays and allocate none:
+#: compiled without Numba's reference counting (``_nrt=False``, an option of ``njit``
+#: exercised by Numba's own tests), so a call passing the state, parameter row and
+#: observation costs no atomic reference-count updates. The functions it calls (the task
+#: modules') are compiled for it with the same option. A function compiled with it must
+#: not create, return or keep an array; ``tests/engine/test_no_refcounts.py`` checks the
+#: compiled code.
+step_kernel = njit(cache=True, error_model="numpy", _nrt=False)
 
 
 @njit(cache=True, error_model="numpy")
@@ -88,12 +103,12 @@ def env_observe(
             noise of a variant with ``noise``); None when the table has none.
     """
     p = params[task]
-    env_observe_row(observe_kind(p), p, state, noise, obs)
+    task_observe(observe_kind(p), p, state, noise, obs)
     if eps is not None and p[P_OBS_SD] != 0.0:
         add_obs_noise(p, eps[0], eps[1], obs)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@step_kernel
 def add_obs_noise(p: np.ndarray, eps0: float, eps1: float, obs: np.ndarray) -> None:
     """Adds a variant's Gaussian observation noise to the inputs that observe the state.
 
@@ -118,7 +133,7 @@ def add_obs_noise(p: np.ndarray, eps0: float, eps1: float, obs: np.ndarray) -> N
 VARIANT_OBSERVATION = -2
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@step_kernel
 def observe_kind(p: np.ndarray) -> int:
     """The observation kind of a parameter row: its base task id, or ``VARIANT_OBSERVATION``."""
     if p[P_OBS] != 0.0:
@@ -126,7 +141,7 @@ def observe_kind(p: np.ndarray) -> int:
     return np.int64(p[P_KIND])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@step_kernel
 def variant_observe(p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray) -> None:
     """A variant's observation: each input a state slot scaled to [-1, 1], or the noise.
 
@@ -148,7 +163,7 @@ def variant_observe(p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndar
             obs[i] = clip_obs(2.0 * (x - lo) / (p[P_OBS_HI + i] - lo) - 1.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@step_kernel
 def task_observe(
     kind: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
 ) -> None:
@@ -180,15 +195,14 @@ def task_observe(
         obs[1] = np.nan
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@step_kernel
 def task_step(
     kind: int, p: np.ndarray, state: np.ndarray, a_d: int, a_c: float
 ) -> tuple[float, bool, bool]:
     """The step dispatch: advances the task of a parameter row by one step in place.
 
-    Inlined into its callers (``inline="always"``), so that the batch kernel's episode
-    loop pays no call passing the state and parameter arrays (each such call costs atomic
-    reference-count updates).
+    Compiled as a :data:`step_kernel` (no reference counting): the batch kernel calls it
+    once per step.
 
     Args:
         kind: The row's base task id (``p[P_KIND]``): which kernels play it.
@@ -218,18 +232,6 @@ def task_step(
         reward, terminated = np.nan, True
     truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]
     return reward, terminated, truncated
-
-
-@njit(cache=True, error_model="numpy")
-def env_observe_row(
-    kind: int, p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray
-) -> None:
-    """:func:`env_observe` given the parameter row ``p = params[task]`` and its ``kind``.
-
-    The batch kernel takes the row and its observation kind (:func:`observe_kind`) once per
-    episode: making the row (an array view) at every step costs reference-count updates.
-    """
-    task_observe(kind, p, state, noise, obs)
 
 
 @njit(cache=True, error_model="numpy")

@@ -16,6 +16,7 @@ same library functions the report uses (:mod:`mtpg.analysis.runs.reported_number
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import subprocess
 import sys
 import warnings
@@ -94,15 +95,23 @@ def build(results: Path, analyze: bool = True) -> Path:
 
     paths = _runs(results)
     runs = [load_run(p) for p in paths]
-    figures = results / "figures"
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        build_report(paths, figures)
-    (figures / "index.html").unlink(missing_ok=True)  # the PNGs are committed instead
     groups, _ = group_runs(runs)
     numbers = {r.path: run_numbers(r) for r in runs}
     tasks = runs[0].tasks
+    # While some runs grow, the figures and summaries (best run, IQM, best single-task
+    # champion, counts) are of the runs at the target generation, so that a run just
+    # begun does not stand beside finished ones in one statistic; every run is listed.
     tpg = groups[0]
+    finished = [r for r in tpg.runs if r.final_generation >= TARGET]
+    partial = bool(finished) and len(finished) < len(tpg.runs)
+    if partial:
+        tpg = dataclasses.replace(tpg, runs=finished)
+    drawn = [r.path for r in runs if r.final_generation >= TARGET] if partial else paths
+    figures = results / "figures"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        build_report(drawn, figures)
+    (figures / "index.html").unlink(missing_ok=True)  # the PNGs are committed instead
     best = best_of([numbers[r.path] for r in tpg.runs])
     per_task, overall = group_estimates(tpg, numbers)
     best_single = {t: max(numbers[r.path].single[t] for r in tpg.runs) for t in tasks}
@@ -129,6 +138,14 @@ def build(results: Path, analyze: bool = True) -> Path:
             "",
         ]
     lines += markdown_table(*status_rows(runs, TARGET)) + [""]
+    if partial:
+        lines += [
+            f"Figures and summaries (best run, interquartile means, best single-task "
+            f"champions, counts) are of the {len(tpg.runs)} TPG runs at generation {TARGET:,} "
+            f"({', '.join(r.path.name for r in tpg.runs)}); the runs still growing are "
+            "listed at their latest test point beside them.",
+            "",
+        ]
     lines += [
         "## Section 5: test scores",
         "",
@@ -155,9 +172,10 @@ def build(results: Path, analyze: bool = True) -> Path:
         [n.run.name, str(n.generation), *(f"{n.normalised[t]:.2f}" for t in tasks)]
         for n in (numbers[r.path] for g in groups for r in g.runs)
     ]
-    rows.append(["IQM over TPG seeds", "", *(e.text(2) for e in per_task)])
+    at = f" at generation {TARGET:,}" if partial else ""
+    rows.append([f"IQM over TPG seeds{at}", "", *(e.text(2) for e in per_task)])
     lines += markdown_table(head, rows)
-    lines += ["", f"IQM over TPG seeds and all tasks: {overall.text(2)}.", ""]
+    lines += ["", f"IQM over TPG seeds{at} and all tasks: {overall.text(2)}.", ""]
     lines += [
         "Every run's all-task champion: mean test return ± the half-width of its 95% "
         f"confidence interval (1.96 std / sqrt(n), n = {runs[0].test_episodes} test "
@@ -190,7 +208,7 @@ def build(results: Path, analyze: bool = True) -> Path:
         "The best run of each experiment against the best single-task champion of the TPG "
         "runs (Fig. 7):",
         "",
-        *markdown_table(*ablation_rows(groups, numbers, best_single, tasks)),
+        *markdown_table(*ablation_rows([tpg, *groups[1:]], numbers, best_single, tasks)),
         "",
     ]
     for name, caption in (

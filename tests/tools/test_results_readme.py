@@ -79,3 +79,31 @@ def test_the_page_gives_each_champion_test_return_with_its_interval(results):
     )
     means = [float(cell.split("±")[0]) for cell in row.split("|")[3:-1]]
     assert means == [float(f"{n.test[t]:.4g}") for t in n.run.tasks]
+
+
+def test_summaries_leave_out_runs_still_growing_once_some_are_finished(
+    results, tmp_path, monkeypatch
+):
+    import shutil
+
+    folder = tmp_path / "results"
+    shutil.copytree(results / "runs", folder / "runs")
+    settings = tiny_args(
+        "CartPole,MountainCar", root_size=16, n_elite=2, evaluation__test_interval=2
+    )
+    done = mtpg(
+        "train", "--preset", "paper", "--seed", "3", *settings,
+        "--set", "evaluation.test_episodes=5", "--generations", "4",
+        "--out", str(folder / "runs" / "TPG-seed3"),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    tests = folder / "runs" / "TPG-seed3" / "tests.csv"  # as if still growing: test point 2
+    head, *rows = tests.read_text().splitlines()
+    column = head.split(",").index("generation")
+    tests.write_text("\n".join([head, *(r for r in rows if int(r.split(",")[column]) <= 2)]) + "\n")
+    monkeypatch.setattr(results_readme, "TARGET", 4)  # seeds 1 and 2 are finished
+    text = results_readme.build(folder, analyze=False).read_text()
+    assert "are of the 2 TPG runs at generation 4 (TPG-seed1, TPG-seed2)" in text
+    assert "| TPG-seed3 | 2 | " in text  # still listed, at its latest test point
+    assert "IQM over TPG seeds at generation 4 |" in text
+    assert "Best TPG run: **TPG-seed" in text and "Best TPG run: **TPG-seed3**" not in text

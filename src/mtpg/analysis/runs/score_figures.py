@@ -37,7 +37,8 @@ def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
     """Fig. 4: test return per task over generations, every run of one group.
 
     Grey: the all-task champion of each run at each test point; black: the best run;
-    dotted: the median over runs of the single-task champion of that task.
+    dotted: the median over runs of the single-task champion of that task (at each test
+    point, over the runs that have reached it).
     """
     plt = pyplot()
     runs = group.runs
@@ -66,12 +67,17 @@ def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
                     else None
                 ),
             )
-        single = [run.curve(task, task) for run in runs]
-        n = min(len(x) for x, _ in single)
-        if n:
-            med = np.median(np.array([y[:n] for _, y in single]), axis=0)
+        # The median at each test point over the runs that have reached it, so that a
+        # run still growing does not cut the others' curve short.
+        at: dict[int, list[float]] = {}
+        for run in runs:
+            for g, v in zip(*run.curve(task, task), strict=True):
+                at.setdefault(int(g), []).append(float(v))
+        if at:
+            gens = sorted(at)
+            med = [float(np.median(at[g])) for g in gens]
             label = "single-task champion" + (" (median over runs)" if len(runs) > 1 else "")
-            ax.plot(single[0][0][:n], med, ":", color="tab:blue", lw=2, label=label)
+            ax.plot(gens, med, ":", color="tab:blue", lw=2, label=label)
         if len(runs) > 1:
             ax.plot([], [], color="0.65", label="all-task champion, other runs")
         ax.set_title(task)

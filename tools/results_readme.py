@@ -102,11 +102,12 @@ def build(results: Path, analyze: bool = True) -> Path:
     # champion, counts) are of the runs at the target generation, so that a run just
     # begun does not stand beside finished ones in one statistic; every run is listed.
     tpg = groups[0]
-    finished = [r for r in tpg.runs if r.final_generation >= TARGET]
+    at_target = {r.path for r in runs if r.final_generation >= TARGET}
+    finished = [r for r in tpg.runs if r.path in at_target]
     partial = bool(finished) and len(finished) < len(tpg.runs)
     if partial:
         tpg = dataclasses.replace(tpg, runs=finished)
-    drawn = [r.path for r in runs if r.final_generation >= TARGET] if partial else paths
+    drawn = [p for p in paths if p in at_target] if partial else paths
     figures = results / "figures"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -129,7 +130,7 @@ def build(results: Path, analyze: bool = True) -> Path:
         "## Status",
         "",
     ]
-    done = all(r.final_generation >= TARGET for r in runs)
+    done = len(at_target) == len(runs)
     if not done:
         lines += [
             "**In progress**: not every run has reached generation 1,000, so every figure "

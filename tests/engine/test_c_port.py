@@ -54,7 +54,7 @@ def test_limits_are_compile_time_constants_checked_against_the_input(tmp_path):
     data = tmp_path / "w.bin"
     c_port.write_input(work, data)
     raw = bytearray(data.read_bytes())
-    raw[12 * 8 : 13 * 8] = np.float64(1e9).tobytes()  # BIG, right after the header
+    raw[13 * 8 : 14 * 8] = np.float64(1e9).tobytes()  # BIG, right after the 13-word header
     data.write_bytes(bytes(raw))
     with pytest.raises(RuntimeError, match="protection limits differ"):
         c_port.run_port(exe, data, len(work.job_roots))

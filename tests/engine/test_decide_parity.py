@@ -46,7 +46,7 @@ def assert_step(cp, steps, t, decision, agent):
 
 
 def compare_sequence(pop, root, obs, marks, no_memory):
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     steps = production_steps(cp, root, obs, marks, no_memory=no_memory)
     agent = ReferenceAgent(pop, root, no_memory=no_memory)
     for t, o in enumerate(obs):
@@ -92,7 +92,7 @@ def test_memory_modes_differ_on_generated_graphs():
     """The comparison has teeth: memory on and off give different kernel outputs."""
     rng = np.random.default_rng(11)
     pop, roots = layered_graphs(rng, 6, teams=3, programs=10, instructions=12)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     obs = observations(rng, 15)
     on = [production_steps(cp, r, obs).memory for r in roots]
     off = [production_steps(cp, r, obs, no_memory=True).memory for r in roots]
@@ -155,7 +155,7 @@ def reference_steps(pop, root, task, start, noise, no_memory, check):
 @pytest.mark.parametrize("no_memory", [False, True])
 def test_decide_matches_reference_on_evolved_graphs(evolved, no_memory):
     pop = evolved.state.population
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     task_ids = [TASK_NAMES.index(t) for t in EVOLVED_TASKS]
     episodes = Episodes.grid(task_ids, held_out_seeds(1))
     # every root, plus internal teams entered through pointers (they decide as roots too)
@@ -182,11 +182,13 @@ def test_decide_matches_reference_on_evolved_graphs(evolved, no_memory):
 def test_stepper_totals_equal_the_batch_kernel(evolved):
     """The step-by-step driver and the batch kernel training uses are one computation."""
     pop = evolved.state.population
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)  # the stepper traces
     episodes = Episodes.grid([TASK_NAMES.index(t) for t in EVOLVED_TASKS], [0])
     roots = pop.roots()
     for no_memory in (False, True):
-        returns, result = evaluate_roots(cp, roots, episodes, no_memory=no_memory)
+        returns, result = evaluate_roots(
+            compile_population(pop), roots, episodes, no_memory=no_memory
+        )  # folded
         for i, root in enumerate(roots):
             for row in range(len(episodes.tasks)):
                 steps, _, rewards = play_episode(cp, root, episodes, row, no_memory)

@@ -25,7 +25,7 @@ def observations(rng, n):
 
 
 def compare_sequence(pop, root, obs, no_memory=False):
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     trace = trace_sequence(cp, root, obs, no_memory=no_memory)
     full = trace_sequence(
         compile_population(pop, remove_introns=False), root, obs, no_memory=no_memory

@@ -24,7 +24,7 @@ def one_team(codes, actions=(0, 1)):
 def test_memory_log_records_the_step_of_the_last_write():
     # program 0: r0 <- m[1] + s[0] (reads m[1]); m[1] <- |s[0]| (writes it)
     pop = one_team([[[0, 0, M1, S0], [12, M1, 0, S0]], [[0, 0, S0, S0]]])
-    trace = trace_sequence(compile_population(pop), 0, np.full((4, 2), 0.5))
+    trace = trace_sequence(compile_population(pop, fold_constants=False), 0, np.full((4, 2), 0.5))
     reads = trace.mem_log[trace.mem_log[:, 3] == 0]
     writes = trace.mem_log[trace.mem_log[:, 3] == 1]
     assert reads[:, 0].tolist() == [0, 1, 2, 3]
@@ -39,7 +39,9 @@ def test_memory_log_records_the_step_of_the_last_write():
 
 def test_no_memory_mode_resets_last_write():
     pop = one_team([[[0, 0, M1, S0], [12, M1, 0, S0]], [[0, 0, S0, S0]]])
-    trace = trace_sequence(compile_population(pop), 0, np.full((3, 2), 0.5), no_memory=True)
+    trace = trace_sequence(
+        compile_population(pop, fold_constants=False), 0, np.full((3, 2), 0.5), no_memory=True
+    )
     reads = trace.mem_log[trace.mem_log[:, 3] == 0]
     assert reads[:, 4].tolist() == [-1, -1, -1]
 
@@ -49,10 +51,10 @@ def test_traced_episode_matches_batch_kernel():
     from mtpg.engine.workload import layered_graphs
 
     pop, roots = layered_graphs(np.random.default_rng(4), 6, teams=3, programs=5, instructions=6)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     for task in range(6):
         eps = Episodes.grid([task], [3])
-        returns, result = evaluate_roots(cp, roots, eps)
+        returns, result = evaluate_roots(compile_population(pop), roots, eps)  # folded
         starts, noise = make_episodes(np.array([task]), np.array([3]))
         for i, root in enumerate(roots):
             trace = trace_episode(cp, root, task, starts[0], noise[0])
@@ -68,7 +70,7 @@ def test_a_run_whose_logs_overflow_is_played_again_with_room_for_all(monkeypatch
     from mtpg.engine.workload import layered_graphs
 
     pop, roots = layered_graphs(np.random.default_rng(5), 2, teams=3, programs=5, instructions=6)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     starts, noise = make_episodes(np.array([0]), np.array([1]))
     roomy = trace_episode(cp, roots[0], 0, starts[0], noise[0], snapshot=True)
     monkeypatch.setattr(record, "FIRST_ROWS", 3)
@@ -91,7 +93,7 @@ def test_a_traced_episode_ends_where_its_noise_row_ends():
     from mtpg.envs.core import ACROBOT
 
     pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=2, programs=4, instructions=4)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     starts, noise = make_episodes(np.array([ACROBOT]), np.array([0]))  # up to 500 steps
     trace = trace_episode(cp, roots[0], ACROBOT, starts[0], noise[0, :8])
     assert len(trace.actions) == 7 and len(trace.states) == 8

@@ -61,9 +61,9 @@ def graph():
 @pytest.mark.parametrize("task", range(N_TASKS), ids=[t.name for t in TASKS])
 def test_every_kernel_dispatches_the_task(task, graph):
     pop, root = graph
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)  # traced too
     episodes = Episodes.grid([task], SEEDS)
-    returns, result = evaluate_roots(cp, [root], episodes)  # training kernel
+    returns, result = evaluate_roots(compile_population(pop), [root], episodes)  # training
     stream = engine_stream(pop, root, [task], SEEDS)  # export harness
     for e, seed in enumerate(SEEDS):
         # tracing kernel
@@ -110,7 +110,7 @@ def test_an_id_without_a_branch_is_loud(graph):
     assert np.isnan(obs).all()
     reward, terminated, truncated = env_step(missing, params, state, 0, 0.0)
     assert np.isnan(reward) and terminated and not truncated
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)  # traced too
     table = Episodes(
         np.array([missing]), np.zeros(1, np.int64), np.zeros((1, STATE_SIZE)), np.zeros((1, 201)),
         np.zeros((1, 0, 2)), params,

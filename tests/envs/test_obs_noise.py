@@ -56,7 +56,7 @@ def test_the_noise_is_added_to_the_observed_input_and_clipped():
 def test_the_gymnasium_environment_plays_the_engines_episode():
     task = resolve(NOISY)
     pop = tangled_population(np.random.default_rng(5), 6, 20, 12, 4, 0.5)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     table = Episodes.grid([task], [11])
     root = list(pop.teams)[0]
     tr = trace_episode(

@@ -64,7 +64,7 @@ def sequence_stream(pop, root, n, seed, no_memory=False, obs=None):
     """A stream of observations (random and extreme by default) as one episode of the engine."""
     obs = random_observations(n, seed) if obs is None else obs
     n = len(obs)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)
     tr = trace_sequence(cp, root, obs, no_memory=no_memory, snapshot=False)
     teams = [
         [int(cp.team_ids[x]) for x in tr.team_log[tr.team_log[:, 0] == t, 1]] for t in range(n)

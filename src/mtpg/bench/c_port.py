@@ -8,11 +8,13 @@ CPU seconds of its timed pass over the jobs (the last of :data:`PASSES`, so warm
 provably do the same work.
 
 Input file layout (native byte order): int64 header ``[n_teams, n_members, n_programs,
-n_instrs, R, M, base, n_banks, n_jobs, n_pool, noise_width, n_constants]``; float64
-``[BIG, DIV_EPS, LOG_BIG, LOG_TINY]``; then ``team_offsets, team_members, prog_offsets``
-(int64), ``instrs`` (uint32, 4 per instruction), ``prog_action, prog_bank, job_roots,
-job_episodes`` (int64), the pool's ``starts`` and ``noise`` (float64, row-major), the
-CartPole parameter row (9 float64) and the constants (float64).
+n_instrs, R, M, base, n_banks, n_jobs, n_pool, noise_width, n_constants, n_folded]``;
+float64 ``[BIG, DIV_EPS, LOG_BIG, LOG_TINY]``; then ``team_offsets, team_members,
+prog_offsets`` (int64), ``instrs`` (uint32, 4 per instruction), ``prog_action, prog_bank,
+prog_count, job_roots, job_episodes`` (int64), the pool's ``starts`` and ``noise``
+(float64, row-major), the CartPole parameter row (9 float64), the constants and the
+folded constants (float64). Both sides run the same compiled, constant-folded code
+(:mod:`mtpg.engine.fold`).
 """
 
 from __future__ import annotations
@@ -110,6 +112,7 @@ def write_input(work: Workload, path: Path) -> None:
         starts.shape[0],
         noise.shape[1],
         len(CONSTANTS),
+        len(cp.graph.folded),
     ]
     parts = [
         np.asarray(header, np.int64),
@@ -120,12 +123,14 @@ def write_input(work: Workload, path: Path) -> None:
         cp.graph.instrs.astype(np.uint32),
         cp.graph.prog_action.astype(np.int64),
         cp.graph.prog_bank.astype(np.int64),
+        cp.graph.prog_count.astype(np.int64),
         work.job_roots.astype(np.int64),
         work.job_episodes.astype(np.int64),
         starts.astype(np.float64),
         noise.astype(np.float64),
         TASK_PARAMS[CARTPOLE, :9].astype(np.float64),
         np.asarray(CONSTANTS, np.float64),
+        cp.graph.folded.astype(np.float64),
     ]
     with open(path, "wb") as f:
         for a in parts:

@@ -28,7 +28,7 @@
 #include <string.h>
 #include <time.h>
 
-enum { N_HEADER = 12, STATE_SIZE = 6, PREV_FORCE = 4, STEP = 5 };
+enum { N_HEADER = 13, STATE_SIZE = 6, PREV_FORCE = 4, STEP = 5 };
 
 /* CartPole parameter columns (mtpg.envs.cartpole). */
 enum { MAX_STEPS, FORCE, TAU, GRAVITY, MASSCART, MASSPOLE, LENGTH, X_THRESHOLD, THETA_THRESHOLD };
@@ -48,7 +48,7 @@ static double clamp(double v)
     return v;
 }
 
-/* The protected operations of Table 2 (mtpg.engine.ops.apply_op). */
+/* The protected operations of Table 2 and the engine's copy (mtpg.engine.ops.apply_op). */
 static double apply_op(uint32_t op, double d, double a, double b)
 {
     double v, x, e;
@@ -81,13 +81,15 @@ static double apply_op(uint32_t op, double d, double a, double b)
     case 12: v = fabs(b); break;
     case 13: v = b * b * b; break;
     case 14: v = a < b ? -d : d; break;
-    default: v = a > b ? -d : d; break;
+    case 15: v = a > b ? -d : d; break;
+    default: return b; /* OP_COPY of a folded constant (mtpg.engine.fold) */
     }
     return clamp(v);
 }
 
 typedef struct {
-    const int64_t *team_offsets, *team_members, *prog_offsets, *prog_action, *prog_bank;
+    const int64_t *team_offsets, *team_members, *prog_offsets, *prog_action, *prog_bank,
+        *prog_count;
     const uint32_t *instrs;
     size_t R, M, base;
 } Graph;
@@ -119,7 +121,7 @@ static int decide(const Graph *g, int64_t root, double *W, int64_t *team_stamp, 
                 const uint32_t *in = g->instrs + 4 * i;
                 W[in[1]] = apply_op(in[0], W[in[1]], W[in[2]], W[in[3]]);
             }
-            counts[1] += g->prog_offsets[p + 1] - g->prog_offsets[p];
+            counts[1] += g->prog_count[p]; /* effective instructions before folding */
             act = g->prog_action[p];
             if ((act < 0 || team_stamp[act] != stamp) && (best_p < 0 || W[0] > best)) {
                 best = W[0];
@@ -183,7 +185,8 @@ typedef struct {
 /* One pass over every job: allocates its buffers, plays every job, returns the outcomes. */
 static Outcome play_all(const Graph *g, int64_t n_teams, int64_t n_banks, int64_t n_jobs,
                         const int64_t *job_root, const int64_t *job_ep, const double *starts,
-                        const double *p, const double *constants, int64_t n_const)
+                        const double *p, const double *constants, int64_t n_const,
+                        const double *folded, int64_t n_folded)
 {
     Outcome o;
     double *W = calloc(g->base + (size_t)n_banks * g->M + 1, sizeof *W);
@@ -201,6 +204,7 @@ static Outcome play_all(const Graph *g, int64_t n_teams, int64_t n_banks, int64_
         bank_stamp[i] = -1;
     memcpy(W + g->R, constants, (size_t)n_const * sizeof *W);
     double *obs = W + g->R + n_const;
+    memcpy(W + g->base - n_folded, folded, (size_t)n_folded * sizeof *W);
     int64_t stamp = 0;
     for (int64_t j = 0; j < n_jobs; j++) {
         int64_t e = job_ep[j], counts[2] = {0, 0}, t = 0;
@@ -256,7 +260,7 @@ int main(int argc, char **argv)
         return 3;
     }
     /* header: n_teams, n_members, n_programs, n_instrs, R, M, base, n_banks, n_jobs, n_pool,
-     * noise width, n_constants */
+     * noise width, n_constants, n_folded */
     int64_t n_teams = h[0], n_prog = h[2], n_jobs = h[8], width = h[10], n_const = h[11];
     double *limits = read_block(f, 4, sizeof(double));
     if (limits[0] != BIG || limits[1] != DIV_EPS || limits[2] != LOG_BIG || limits[3] != LOG_TINY) {
@@ -269,6 +273,7 @@ int main(int argc, char **argv)
     g.instrs = read_block(f, 4 * (size_t)h[3], sizeof(uint32_t));
     g.prog_action = read_block(f, (size_t)n_prog, sizeof(int64_t));
     g.prog_bank = read_block(f, (size_t)n_prog, sizeof(int64_t));
+    g.prog_count = read_block(f, (size_t)n_prog, sizeof(int64_t));
     g.R = (size_t)h[4], g.M = (size_t)h[5], g.base = (size_t)h[6];
     int64_t *job_root = read_block(f, (size_t)n_jobs, sizeof(int64_t));
     int64_t *job_ep = read_block(f, (size_t)n_jobs, sizeof(int64_t));
@@ -276,6 +281,7 @@ int main(int argc, char **argv)
     double *noise = read_block(f, (size_t)h[9] * (size_t)width, sizeof(double));
     double *p = read_block(f, 9, sizeof(double));
     double *constants = read_block(f, (size_t)n_const, sizeof(double));
+    double *folded = read_block(f, (size_t)h[12], sizeof(double));
     fclose(f);
     (void)noise; /* CartPole observes both inputs: the noise rows are not read */
 
@@ -284,7 +290,8 @@ int main(int argc, char **argv)
         free(o.returns);
         free(o.counts);
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t0);
-        o = play_all(&g, n_teams, h[7], n_jobs, job_root, job_ep, starts, p, constants, n_const);
+        o = play_all(&g, n_teams, h[7], n_jobs, job_root, job_ep, starts, p, constants, n_const,
+                     folded, h[12]);
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t1);
     }
 

@@ -2,16 +2,19 @@
 
 The kernels work on one float64 *workspace* per thread:
 
-============================  ==========================================
-``[0, R)``                    private registers ``r``
-``[R, R+18)``                 the constants
-``[R+18, R+18+n_obs)``        the observation
-``[BASE + b*M, BASE+(b+1)*M)`` memory bank ``b`` (dense index), ``BASE = R+18+n_obs``
-============================  ==========================================
+=================================  ==========================================
+``[0, R)``                         private registers ``r``
+``[R, R+18)``                      the constants
+``[R+18, R+18+n_obs)``             the observation
+``[R+18+n_obs, BASE)``             the folded constants (``Graph.folded``)
+``[BASE + b*M, BASE+(b+1)*M)``     memory bank ``b`` (dense index)
+=================================  ==========================================
 
 Instruction operands are rewritten from the logical layout of
 :mod:`mtpg.model.instructions` to absolute workspace indices, so a program touches its
-memory bank in place with no copying. Introns are dropped here (:func:`effective_mask`).
+memory bank in place with no copying. Introns are dropped here (:func:`effective_mask`),
+and instructions whose result is known before the program runs are folded into
+constants (:mod:`mtpg.engine.fold`; on by default, off for the tracer).
 
 Only banks some program points to are compiled: a bank of the population that no program
 uses (a fresh bank) can never be read or written, so it needs no workspace.
@@ -25,6 +28,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from mtpg.engine.fold import first_folded, folded_code
 from mtpg.model.graph import Population, Program
 from mtpg.model.instructions import (
     N_CONSTANTS,
@@ -53,6 +57,9 @@ class Graph(NamedTuple):
         prog_action: int64 ``[n_programs]``: dense team index, or ``-1 - a`` for atomic
             action ``a``.
         prog_bank: int64 ``[n_programs]``: dense memory bank index.
+        prog_count: int64 ``[n_programs]``: effective instructions of each program before
+            folding (what the kernels count as executed, folded or not).
+        folded: float64 ``[K]``: the folded constants, at workspace ``mem_base - K``.
         n_registers: Private registers per program (``R``).
         n_memory: Registers per memory bank (``M``).
         mem_base: Workspace index of memory bank 0.
@@ -64,6 +71,8 @@ class Graph(NamedTuple):
     instrs: np.ndarray
     prog_action: np.ndarray
     prog_bank: np.ndarray
+    prog_count: np.ndarray
+    folded: np.ndarray
     n_registers: int
     n_memory: int
     mem_base: int
@@ -80,6 +89,7 @@ class CompiledPopulation:
         program_ids: int64 ``[n_programs]``: model program id of each dense index.
         bank_ids: int64 ``[n_banks]``: model bank id of each dense bank index.
         n_instructions: int64 ``[n_programs]``: instructions before intron removal.
+        folded: Compiled with constant folding (the tracer refuses such code).
     """
 
     layout: RegisterLayout
@@ -88,6 +98,7 @@ class CompiledPopulation:
     program_ids: np.ndarray
     bank_ids: np.ndarray
     n_instructions: np.ndarray
+    folded: bool = False
 
     @property
     def mem_base(self) -> int:
@@ -180,12 +191,17 @@ def effective_code(prog: Program, layout: RegisterLayout) -> np.ndarray:
     return prog.effective
 
 
-def compile_population(pop: Population, remove_introns: bool = True) -> CompiledPopulation:
+def compile_population(
+    pop: Population, remove_introns: bool = True, fold_constants: bool = True
+) -> CompiledPopulation:
     """Flattens a population for the kernels.
 
     Args:
         pop: The population (all teams are compiled; roots are chosen at run time).
         remove_introns: Drop instructions that affect neither ``r[0]`` nor memory.
+        fold_constants: Fold instructions whose result is known before the program runs
+            (:mod:`mtpg.engine.fold`; needs ``remove_introns``). Results are identical
+            either way; the tracer needs the code unfolded.
 
     Returns:
         The compiled population.
@@ -213,9 +229,14 @@ def compile_population(pop: Population, remove_introns: bool = True) -> Compiled
         blocks = [effective_code(p, layout) for p in progs]
     else:
         blocks = [p.instructions for p in progs]
+    counts = np.array([len(b) for b in blocks], dtype=np.int64)
+    fold = fold_constants and remove_introns
+    pool = np.zeros(0)
+    if fold:
+        blocks, pool = _fold_blocks(progs, blocks, layout)
     lengths = np.array([len(b) for b in blocks], dtype=np.int64)
     code = np.concatenate(blocks) if blocks else np.zeros((0, 4), np.int32)
-    mem_base = r + N_CONSTANTS + layout.n_obs
+    mem_base = r + N_CONSTANTS + layout.n_obs + len(pool)
     bank_per_instr = np.repeat(prog_bank, lengths)[:, None]
     operands = code[:, 1:].astype(np.int64)
     mapped = np.where(
@@ -233,6 +254,8 @@ def compile_population(pop: Population, remove_introns: bool = True) -> Compiled
         instrs=instrs,
         prog_action=prog_action,
         prog_bank=prog_bank.astype(np.int64),
+        prog_count=counts,
+        folded=pool,
         n_registers=r,
         n_memory=m,
         mem_base=mem_base,
@@ -244,4 +267,33 @@ def compile_population(pop: Population, remove_introns: bool = True) -> Compiled
         program_ids=program_ids,
         bank_ids=bank_ids.astype(np.int64),
         n_instructions=np.array([len(p.instructions) for p in progs], dtype=np.int64),
+        folded=fold,
     )
+
+
+def _fold_blocks(
+    progs: list[Program], blocks: list[np.ndarray], layout: RegisterLayout
+) -> tuple[list[np.ndarray], np.ndarray]:
+    """Folds every program and merges their pool values into one pool of distinct values.
+
+    Returns:
+        The folded blocks, their pool operands numbered in the merged pool (logical index
+        :func:`~mtpg.engine.fold.first_folded` ``+ k``), and the merged pool.
+    """
+    folded = [folded_code(p, b, layout) for p, b in zip(progs, blocks, strict=True)]
+    values = [v for _, v in folded]
+    if not values or not sum(len(v) for v in values):
+        return [c for c, _ in folded], np.zeros(0)
+    flat = np.concatenate(values)
+    # Distinct by bits (0.0 and -0.0 stay apart); the pool is sorted by bit pattern.
+    bits, slot = np.unique(flat.view(np.int64), return_inverse=True)
+    first = first_folded(layout)
+    out, offset = [], 0
+    for c, v in folded:
+        if len(v):
+            c = c.copy()
+            pooled = c[:, 1:] >= first
+            c[:, 1:][pooled] = first + slot[offset + c[:, 1:][pooled] - first]
+            offset += len(v)
+        out.append(c)
+    return out, bits.view(np.float64)

@@ -104,6 +104,9 @@ def thread_buffers(g) -> Buffers:
     R, M, base = g.n_registers, g.n_memory, g.mem_base
     n_banks = (g.prog_bank.max() + 1) if len(g.prog_bank) else 0
     W = new_workspace(base + n_banks * M, R)
+    K = len(g.folded)
+    for i in range(K):  # the folded constants, just below bank 0
+        W[base - K + i] = g.folded[i]
     return Buffers(
         W,
         W[R + N_CONSTANTS : R + N_CONSTANTS + 2],
@@ -141,7 +144,7 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
         ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
     """
     team_offsets, team_members, prog_offsets = g.team_offsets, g.team_members, g.prog_offsets
-    instrs, prog_action, prog_bank = g.instrs, g.prog_action, g.prog_bank
+    instrs, prog_action, prog_bank, prog_count = g.instrs, g.prog_action, g.prog_bank, g.prog_count
     R, M, base = g.n_registers, g.n_memory, g.mem_base
     W, team_stamp, bank_stamp, counts = buf.W, buf.team_stamp, buf.bank_stamp, buf.counts
     # Every index below is unsigned (np.uint64): Numba then emits plain loads and stores,
@@ -186,7 +189,7 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
                 if rec is not None:
                     record_instruction(rec, i, instrs[i], W[dst], value, base, M)
                 W[dst] = value
-            n_instr += hi - lo
+            n_instr += np.uint64(prog_count[p])  # as stated, folded or not
             bid = W[0]
             if rec is not None:
                 record_program(rec, p, bid)

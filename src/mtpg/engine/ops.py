@@ -11,7 +11,11 @@ import math
 
 from numba import njit
 
-from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, LOG_TINY
+from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, LOG_TINY, N_OPS
+
+#: Engine-only op code (never in a program): ``dst <- src2``, the copy that constant
+#: folding (:mod:`mtpg.engine.fold`) writes where a known value must reach a register.
+OP_COPY = N_OPS
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -19,7 +23,7 @@ def apply_op(op: int, d: float, a: float, b: float) -> float:
     """Computes one instruction's new target value (inlined into the decision kernel).
 
     Args:
-        op: Op code (0..15).
+        op: Op code (0..15, or :data:`OP_COPY`).
         d: Current value of the target (read by the conditionals).
         a: First operand.
         b: Second operand.
@@ -67,8 +71,10 @@ def apply_op(op: int, d: float, a: float, b: float) -> float:
         v = b * b * b
     elif op == 14:
         v = -d if a < b else d
-    else:
+    elif op == 15:
         v = -d if a > b else d
+    else:  # OP_COPY: a value already within [-BIG, BIG]
+        return b
     if v > BIG:
         return BIG
     if v < -BIG:

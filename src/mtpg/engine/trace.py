@@ -102,6 +102,14 @@ def _trace(rec: Recorder, steps: int) -> Trace:
     )
 
 
+def _check_unfolded(cp: CompiledPopulation) -> None:
+    """The tracer logs instructions as programs state them: it needs unfolded code."""
+    if cp.folded:
+        raise ValueError(
+            "trace needs code compiled with compile_population(..., fold_constants=False)"
+        )
+
+
 def trace_sequence(
     cp: CompiledPopulation,
     root_id: int,
@@ -124,6 +132,7 @@ def trace_sequence(
     Returns:
         The trace (states and rewards are zero: no task runs).
     """
+    _check_unfolded(cp)
     obs = np.ascontiguousarray(observations, dtype=np.float64).reshape(-1, 2)
     if episode_of_step is None:
         episode_of_step = np.zeros(len(obs), dtype=np.int64)
@@ -155,6 +164,7 @@ def trace_episode(
 
     ``obs_noise``: the episode's rows ``[T + 1, 2]``, for a variant with observation noise.
     """
+    _check_unfolded(cp)
     root = cp.team_index(root_id)
     table = Episodes.single(task, start, noise, obs_noise)
     jobs = Jobs(np.array([root], dtype=np.int64), np.zeros(1, dtype=np.int64))

@@ -169,7 +169,7 @@ def engine_stream(
     """
     from mtpg.engine.batch import Episodes
 
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
     table = Episodes.grid(list(tasks), list(seeds))
     obs_rows, starts, actions, teams = [], [], [], []
     o = np.zeros(2)

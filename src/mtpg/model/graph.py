@@ -49,6 +49,8 @@ class Program:
         effective: Cache of the effective (non-intron) instructions, filled by the
             compiler. Instructions are never changed in place (variation copies a
             program before mutating it), so the cache stays valid.
+        folded: Cache of the constant-folded effective code and its pool values
+            (:func:`mtpg.engine.fold.folded_code`), valid for the same reason.
     """
 
     id: int
@@ -56,6 +58,7 @@ class Program:
     action: int
     bank: int
     effective: np.ndarray | None = field(default=None, repr=False, compare=False)
+    folded: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False, compare=False)
 
     @property
     def is_atomic(self) -> bool:

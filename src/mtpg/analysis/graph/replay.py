@@ -167,7 +167,7 @@ def replay_task(
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     task_id = resolve(task)
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
     seeds = held_out_seeds(episodes, seed)
     starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds)
     n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
@@ -196,7 +196,7 @@ def replay_observations(
     No task runs: ``task`` is empty, ``task_id`` -1, hidden states and rewards are 0.
     Useful to probe a graph with inputs of one's own making.
     """
-    cp = compile_population(pop)
+    cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
     trace = trace_sequence(cp, root, observations, no_memory=no_memory, snapshot=True)
     header = {"task": "", "task_id": -1, "seed": 0, "episode_seeds": np.zeros(1, np.int64)}
     return _assemble(pop, root, cp, [trace], header, no_memory, 1)

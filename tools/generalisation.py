@@ -40,6 +40,8 @@ SETTINGS: dict[str, list[str]] = {
         "evaluation.validation_top_k=5",
         "evaluation.resample_interval=10",
     ],
+    "resampling-5": ["evaluation.resample_interval=5"],
+    "resampling-1": ["evaluation.resample_interval=1"],
 }
 
 

@@ -109,6 +109,14 @@ def test_a_conditional_on_a_known_target_gets_the_value_first():
     assert program_code(cp)[:, 0].tolist() == [OP_COPY, OP_IF_LT]
 
 
+def test_a_conditional_known_to_be_false_is_dropped():
+    # IF 0.1 < -0.1 THEN m0 <- -m0 never fires; IF -0.1 < 0.1 THEN m0 <- -m0 always does
+    _, cp, _ = compiled((OP_IF_LT, M0, const(0.1), const(-0.1)), (OP_ADD, M0, M0, OBS))
+    assert program_code(cp)[:, 0].tolist() == [OP_ADD]
+    _, cp, _ = compiled((OP_IF_LT, M0, const(-0.1), const(0.1)), (OP_ADD, M0, M0, OBS))
+    assert program_code(cp)[:, 0].tolist() == [OP_IF_LT, OP_ADD]
+
+
 def test_the_tracer_refuses_folded_code():
     pop, cp, plain = compiled((OP_COS, 1, 0, const(0.4)), (OP_MUL, M0, 1, OBS))
     with pytest.raises(ValueError, match="fold_constants=False"):

@@ -15,6 +15,7 @@ same floating-point operations and math-library calls), and puts them in a pool 
   for the rest of this execution;
 * a conditional whose target is a private register of known value, but whose condition
   is not known, first gets the target's value copied in;
+* a conditional whose condition is known to be false is not executed;
 * at the end, when the bid ``r[0]`` is known but the register would not hold it, one
   copy writes it.
 
@@ -102,6 +103,8 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
             n_val += 1
             n_out += 1
             continue
+        if cond and ka and kb and not (va < vb if op == OP_IF_LT else va > vb):
+            continue  # a condition known to be false: the instruction changes nothing
         # Executed: reads of known private registers go to the pool instead.
         if cond and dst < n_r and is_known[dst]:
             values[n_val] = known[dst]

@@ -40,6 +40,7 @@ SETTINGS: dict[str, list[str]] = {
         "evaluation.validation_top_k=5",
         "evaluation.resample_interval=10",
     ],
+    "resampling-6ep": ["evaluation.resample_interval=10", "evaluation.train_episodes=6"],
     "resampling-20": ["evaluation.resample_interval=20"],
     "resampling-5": ["evaluation.resample_interval=5"],
     "resampling-1": ["evaluation.resample_interval=1"],

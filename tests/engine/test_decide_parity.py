@@ -8,14 +8,14 @@ graphs from a real evolved population.
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from decide_stepper import play_episode, production_steps
+from graph_strategies import tangled_cases
 from mtpg.config import build_config
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.reference import ReferenceAgent
-from mtpg.engine.workload import layered_graphs, tangled_population
+from mtpg.engine.workload import layered_graphs
 from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
 from mtpg.envs.core import STATE_SIZE, TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds
@@ -57,20 +57,9 @@ def compare_sequence(pop, root, obs, marks, no_memory):
 
 
 @settings(max_examples=40, deadline=None, derandomize=True)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    n_teams=st.integers(1, 8),
-    n_programs=st.integers(2, 30),
-    max_len=st.integers(1, 40),
-    n_banks=st.integers(1, 6),
-    p_pointer=st.sampled_from([0.0, 0.3, 0.7, 0.95]),
-    no_memory=st.booleans(),
-)
-def test_decide_matches_reference_on_generated_graphs(
-    seed, n_teams, n_programs, max_len, n_banks, p_pointer, no_memory
-):
-    rng = np.random.default_rng(seed)
-    pop = tangled_population(rng, n_teams, n_programs, max_len, n_banks, p_pointer)
+@given(case=tangled_cases())
+def test_decide_matches_reference_on_generated_graphs(case):
+    rng, pop, no_memory = case
     check_invariants(pop)
     root = int(rng.choice(list(pop.teams)))
     # three episodes back to back on one set of buffers: the lazy bank reset must make

@@ -5,13 +5,13 @@ import math
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
+from graph_strategies import tangled_cases
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.ops import OP_COPY
 from mtpg.engine.trace import trace_sequence
-from mtpg.engine.workload import layered_graphs, tangled_population
+from mtpg.engine.workload import layered_graphs
 from mtpg.model.graph import Population, atomic
 from mtpg.model.instructions import (
     CONSTANTS,
@@ -134,20 +134,9 @@ def test_folding_removes_math_library_calls_from_random_code():
 
 
 @settings(max_examples=25, deadline=None, derandomize=True)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    n_teams=st.integers(1, 8),
-    n_programs=st.integers(2, 30),
-    max_len=st.integers(1, 40),
-    n_banks=st.integers(1, 6),
-    p_pointer=st.sampled_from([0.0, 0.3, 0.7, 0.95]),
-    no_memory=st.booleans(),
-)
-def test_folded_and_plain_code_play_every_task_identically(
-    seed, n_teams, n_programs, max_len, n_banks, p_pointer, no_memory
-):
-    rng = np.random.default_rng(seed)
-    pop = tangled_population(rng, n_teams, n_programs, max_len, n_banks, p_pointer)
+@given(case=tangled_cases())
+def test_folded_and_plain_code_play_every_task_identically(case):
+    rng, pop, no_memory = case
     roots = sorted(pop.teams)  # every team, internal ones too, decides as a root
     episodes = Episodes.grid(list(range(6)), [int(rng.integers(0, 1000)), 7])
     folded, plain = compile_population(pop), compile_population(pop, fold_constants=False)

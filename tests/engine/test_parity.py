@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
+from graph_strategies import tangled_cases
 from mtpg.engine.batch import Episodes, evaluate_roots, run_jobs
 from mtpg.engine.compile import compile_population
 from mtpg.engine.reference import ReferenceAgent, reference_episode
@@ -66,20 +66,9 @@ def compare_sequence(pop, root, obs, no_memory=False):
 
 
 @settings(max_examples=60, deadline=None, derandomize=True)
-@given(
-    seed=st.integers(0, 2**32 - 1),
-    n_teams=st.integers(1, 8),
-    n_programs=st.integers(2, 30),
-    max_len=st.integers(1, 40),
-    n_banks=st.integers(1, 6),
-    p_pointer=st.sampled_from([0.0, 0.3, 0.7, 0.95]),
-    no_memory=st.booleans(),
-)
-def test_random_tangled_graphs_match_reference(
-    seed, n_teams, n_programs, max_len, n_banks, p_pointer, no_memory
-):
-    rng = np.random.default_rng(seed)
-    pop = tangled_population(rng, n_teams, n_programs, max_len, n_banks, p_pointer)
+@given(case=tangled_cases())
+def test_random_tangled_graphs_match_reference(case):
+    rng, pop, no_memory = case
     check_invariants(pop)
     root = int(rng.choice(list(pop.teams)))
     trace = compare_sequence(pop, root, observations(rng, 12), no_memory=no_memory)

@@ -51,6 +51,16 @@ _CONSTANTS = np.asarray(CONSTANTS, dtype=np.float64)
 
 
 @njit(cache=True, error_model="numpy")
+def _operand(x, known, is_known, constants, first_const):
+    """``(known, value)`` of logical operand ``x``: a register, a constant or an input."""
+    if x < first_const:
+        return is_known[x], known[x]
+    if x < first_const + len(constants):
+        return True, constants[x - first_const]
+    return False, 0.0  # the observation: known only when the program runs
+
+
+@njit(cache=True, error_model="numpy")
 def _fold_kernel(code, n_r, first_const, constants, first_folded):
     """Folds one program's effective ``code`` (logical operands); see the module docstring.
 
@@ -68,29 +78,14 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
     r0_written = False  # an executed instruction wrote r[0]
     n_out = 0
     n_val = 0
-    n_const = len(constants)
     for k in range(n):
         op, dst, a, b = code[k, 0], code[k, 1], code[k, 2], code[k, 3]
         reads_a = not (OP_COS <= op <= OP_CUBE)  # unary operations read only b
         cond = op >= OP_IF_LT  # conditionals also read their target
-        # Each operand read: known (value) or not.
-        ka, kb, kd = True, True, True
-        va, vb, vd = 0.0, 0.0, 0.0
-        if reads_a:
-            if a < first_const:
-                ka, va = is_known[a], known[a]
-            elif first_const <= a < first_const + n_const:
-                va = constants[a - first_const]
-            else:
-                ka = False
-        if b < first_const:
-            kb, vb = is_known[b], known[b]
-        elif first_const <= b < first_const + n_const:
-            vb = constants[b - first_const]
-        else:
-            kb = False
-        if cond:
-            kd, vd = is_known[dst], known[dst]
+        # Each operand read: known (and its value) or not.
+        ka, va = _operand(a, known, is_known, constants, first_const) if reads_a else (True, 0.0)
+        kb, vb = _operand(b, known, is_known, constants, first_const)
+        kd, vd = (is_known[dst], known[dst]) if cond else (True, 0.0)
         if ka and kb and kd:
             v = apply_op(op, vd, va, vb)
             known[dst] = v

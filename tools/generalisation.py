@@ -248,8 +248,15 @@ def _figure(rows: list[dict], path: Path) -> None:
         low = [r["all"]["iqm"] - r["all"]["low"] for r in mine]
         high = [r["all"]["high"] - r["all"]["iqm"] for r in mine]
         errors = [[v if v == v else 0 for v in low], [v if v == v else 0 for v in high]]
-        ax.bar(x, values, yerr=errors, capsize=3, color="#4c72b0")
-        ax.set_xticks(list(x), [r["setting"] for r in mine], rotation=30, ha="right")
+        ax.bar(x, values, yerr=errors, capsize=3, color="#4c72b0", label="IQM, 95% CI")
+        for i, r in enumerate(mine):  # every run (its mean over tasks), seed by seed
+            runs = [sum(s) / len(s) for s in r["all"]["per_run"]]
+            ax.plot([i] * len(runs), runs, "o", ms=3, color="black", alpha=0.6)
+        ax.plot([], [], "o", ms=3, color="black", alpha=0.6, label="one run")
+        labels = [f"{r['setting']} (n={len(r['seeds'])})" for r in mine]
+        ax.set_xticks(list(x), labels, rotation=30, ha="right")
+        if ax is axes[0][0]:
+            ax.legend(fontsize=7, loc="upper left")
         ax.set_title(name)
         ax.set_ylabel("normalised test score (IQM)")
         ax.axhline(1.0, color="grey", lw=0.8, ls="--")

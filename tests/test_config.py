@@ -104,7 +104,14 @@ def test_demo_preset_is_small_and_valid() -> None:
     assert demo.elites_per_subset == 4  # max(4, ceil(100 / 63) = 2)
     one = build_config("demo", overrides=['evaluation.tasks=["Pendulum"]'])
     assert one.elites_per_subset == 100  # the floor serves single-task runs
-    assert set(PRESETS) == {"paper", "demo"}
+    assert set(PRESETS) == {"paper", "demo", "robust"}
+
+
+def test_robust_preset_is_the_paper_with_resampled_training_episodes() -> None:
+    robust, paper = to_dict(build_config("robust")), to_dict(build_config("paper"))
+    assert robust["evaluation"].pop("resample_interval") == 10
+    assert paper["evaluation"].pop("resample_interval") == 0
+    assert robust == paper
 
 
 def test_ablations_each_change_one_setting() -> None:
@@ -208,7 +215,7 @@ def test_validation_messages_name_field_rule_and_value() -> None:
         build_config("paper", overrides=["team.nope=1"])
     with pytest.raises(ConfigError, match=r"^team must be a table, got 3$"):
         build_config("paper", overrides=["team=3"])
-    with pytest.raises(ConfigError, match=r"^unknown preset 'x'; choose from paper, demo$"):
+    with pytest.raises(ConfigError, match=r"^unknown preset 'x'; choose from paper, demo, robust$"):
         build_config("x")
 
 

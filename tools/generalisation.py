@@ -41,6 +41,13 @@ SETTINGS: dict[str, list[str]] = {
         "evaluation.resample_interval=10",
     ],
     "resampling-6ep": ["evaluation.resample_interval=10", "evaluation.train_episodes=6"],
+    "combined-6ep": [
+        "evaluation.validation_episodes=10",
+        "evaluation.validation_top_k=5",
+        "evaluation.resample_interval=10",
+        "evaluation.train_episodes=6",
+    ],
+    "resampling-12ep": ["evaluation.resample_interval=10", "evaluation.train_episodes=12"],
     "resampling-20": ["evaluation.resample_interval=20"],
     "resampling-5": ["evaluation.resample_interval=5"],
     "resampling-1": ["evaluation.resample_interval=1"],

@@ -171,6 +171,11 @@ class EvaluationConfig:
     """Beyond the paper: every this many generations the training episodes are redrawn
     (seeds disjoint from validation and test) and every surviving root is evaluated
     again on them. 0 (the paper): one fixed set, each root evaluated once for life."""
+    resample_mean: bool = False
+    """Beyond the paper, with ``resample_interval``: a surviving root's training score is
+    the mean of its scores on every training block it has played, each block weighing
+    alike (explicit averaging over re-evaluations, Jin and Branke 2005), so the estimate
+    sharpens the longer a root survives. False: its score on the current block alone."""
     references: tuple[str, ...] = ()
     """Reference scores given for variants among ``tasks``, one entry per variant:
     ``"TASK: best=NUMBER[, random=NUMBER], source=TEXT"`` (``[[task]]`` tables take
@@ -208,6 +213,12 @@ class EvaluationConfig:
             minimum=0,
         )
         _positive(self, "evaluation", ("validation_top_k",))
+        _check(
+            not self.resample_mean or self.resample_interval > 0,
+            "evaluation.resample_mean",
+            "needs evaluation.resample_interval > 0",
+            self.resample_mean,
+        )
         self._check_references()
 
     def _check_references(self) -> None:

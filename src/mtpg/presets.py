@@ -35,6 +35,7 @@ EXTENSIONS: dict[str, tuple[str, ...]] = {
         "validation_episodes",
         "validation_top_k",
         "resample_interval",
+        "resample_mean",
         "references",
     ),
 }

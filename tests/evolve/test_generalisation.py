@@ -43,7 +43,8 @@ TINY = [
 ]
 ON = ["evaluation.validation_episodes=3", "evaluation.validation_top_k=3"]
 RESAMPLE = ["evaluation.resample_interval=2"]
-NEW_FIELDS = ("validation_episodes", "validation_top_k", "resample_interval")
+MEAN = [*RESAMPLE, "evaluation.resample_mean=true"]
+NEW_FIELDS = ("validation_episodes", "validation_top_k", "resample_interval", "resample_mean")
 
 
 def tiny(*extra: str) -> RunConfig:
@@ -63,6 +64,8 @@ def tiny(*extra: str) -> RunConfig:
         ("evaluation.resample_interval=-1", "evaluation.resample_interval"),
         ("evaluation.resample_interval=1.5", "evaluation.resample_interval"),
         ('evaluation.validation_episodes="many"', "evaluation.validation_episodes"),
+        ("evaluation.resample_mean=true", "evaluation.resample_mean"),  # needs an interval
+        ("evaluation.resample_mean=1", "evaluation.resample_mean"),
     ],
 )
 def test_bad_values_are_refused_naming_the_field(override: str, field: str) -> None:
@@ -74,7 +77,7 @@ def test_bad_values_are_refused_naming_the_field(override: str, field: str) -> N
 @pytest.mark.parametrize("preset", ["paper", "demo"])
 def test_the_options_are_off_in_the_presets(preset: str) -> None:
     ev = build_config(preset).evaluation
-    assert (ev.validation_episodes, ev.resample_interval) == (0, 0)
+    assert (ev.validation_episodes, ev.resample_interval, ev.resample_mean) == (0, 0, False)
 
 
 def test_the_options_are_in_config_toml_and_read_back() -> None:
@@ -177,6 +180,7 @@ def _state(tr: Trainer) -> tuple:
         st.elites,
         st.champions,
         {r: s.tolist() for r, s in st.validation.items()},
+        {r: (n, t.tolist()) for r, (n, t) in st.blocks.items()},
         st.rng.bit_generator.state,
     )
 
@@ -268,7 +272,7 @@ def test_without_resampling_a_root_is_scored_once_for_life() -> None:
     tr.close()
 
 
-@pytest.mark.parametrize("options", [ON, RESAMPLE, ON + RESAMPLE])
+@pytest.mark.parametrize("options", [ON, RESAMPLE, ON + RESAMPLE, MEAN, ON + MEAN])
 def test_a_run_continued_from_its_payload_equals_the_uninterrupted_one(options) -> None:
     config = tiny(*options)
     whole, rows, _ = _run(config, 5)

@@ -96,7 +96,7 @@ def state_to_payload(state: TrainerState) -> dict[str, Any]:
 
 
 def _validation_payload(state: TrainerState) -> dict[str, Any]:
-    """Validation scores and per-episode returns, each stored only when its option is on.
+    """Validation scores, per-episode returns and block counts, each only when its option is on.
 
     With every option off (the paper) the payload has neither key, as before they existed.
     """
@@ -108,6 +108,11 @@ def _validation_payload(state: TrainerState) -> dict[str, Any]:
         out["returns"] = [
             [int(root), [[float(x) for x in task] for task in table]]
             for root, table in sorted(state.returns.items())
+        ]
+    if state.config.evaluation.resample_mean:
+        out["blocks"] = [
+            [int(root), int(n), [float(x) for x in total]]
+            for root, (n, total) in sorted(state.blocks.items())
         ]
     return out
 
@@ -138,6 +143,10 @@ def state_from_payload(payload: dict[str, Any]) -> tuple[TrainerState, RunConfig
             },
             returns={
                 int(r): np.array(table, dtype=np.float64) for r, table in payload.get("returns", [])
+            },
+            blocks={
+                int(r): (int(n), np.array(total, dtype=np.float64))
+                for r, n, total in payload.get("blocks", [])
             },
         )
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
@@ -180,6 +189,11 @@ def _check_consistent(state: TrainerState, payload: dict[str, Any]) -> None:
     bad = [r for r, table in state.returns.items() if table.shape != shape or r not in pop.teams]
     if bad:
         raise FormatError(f"run state: root {bad[0]} has returns of the wrong shape or no team")
+    if cfg.evaluation.resample_mean and (
+        set(state.blocks) != set(state.scores)
+        or any(n < 1 or t.shape != (n_tasks,) for n, t in state.blocks.values())
+    ):
+        raise FormatError("run state: block counts and sums must be given for every scored root")
     if state.generation > 0:
         subsets = cfg.evaluation.n_subsets
         if len(state.champions) != subsets:

@@ -99,6 +99,8 @@ class TrainerState:
             validation episodes (only with ``evaluation.validation_episodes > 0``).
         returns: Training return of every root per task and episode, ``[n_tasks,
             train_episodes]`` (only with ``team.parent_selection = "lexicase"``).
+        blocks: Training blocks each root has played and the sum of its scores on them,
+            whose quotient is its score (only with ``evaluation.resample_mean``).
     """
 
     config: RunConfig
@@ -110,6 +112,7 @@ class TrainerState:
     rng: np.random.Generator
     validation: dict[int, np.ndarray] = field(default_factory=dict)
     returns: dict[int, np.ndarray] = field(default_factory=dict)
+    blocks: dict[int, tuple[int, np.ndarray]] = field(default_factory=dict)
 
     @classmethod
     def new(cls, config: RunConfig) -> TrainerState:
@@ -297,6 +300,11 @@ class Trainer:
         per_episode = returns.reshape(len(todo), len(self.task_ids), ev.train_episodes)
         for root, row in zip(todo, per_episode.mean(axis=2), strict=True):
             st.scores[root] = row
+            if ev.resample_mean:  # the mean over the blocks the root has played
+                n, total = st.blocks[root] if root in survivors else (0, None)
+                total = row if total is None else total + row
+                st.blocks[root] = (n + 1, total)
+                st.scores[root] = total / (n + 1) if n else row
         if self.config.team.parent_selection == "lexicase":
             for root, table in zip(todo, per_episode, strict=True):
                 st.returns[root] = table
@@ -318,6 +326,7 @@ class Trainer:
                 del st.scores[rid]
                 st.validation.pop(rid, None)
                 st.returns.pop(rid, None)
+                st.blocks.pop(rid, None)
         while True:  # internal teams whose last referrer died: never agents, deleted
             orphans = [t for t, d in pop.in_degree().items() if d == 0 and t not in keep]
             if not orphans:

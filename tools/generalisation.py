@@ -51,6 +51,17 @@ SETTINGS: dict[str, list[str]] = {
     "resampling-20": ["evaluation.resample_interval=20"],
     "resampling-5": ["evaluation.resample_interval=5"],
     "resampling-1": ["evaluation.resample_interval=1"],
+    "lexicase-resampling-6ep": [
+        "team.parent_selection=lexicase",
+        "evaluation.resample_interval=10",
+        "evaluation.train_episodes=6",
+    ],
+    "resampling-mean": ["evaluation.resample_interval=10", "evaluation.resample_mean=true"],
+    "resampling-mean-6ep": [
+        "evaluation.resample_interval=10",
+        "evaluation.resample_mean=true",
+        "evaluation.train_episodes=6",
+    ],
 }
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 TOOL = Path(__file__).resolve().parents[2] / "tools" / "generalisation.py"
+ORACLE = TOOL.with_name("population_oracle.py")
 SMALL = [
     "--generations",
     "2",
@@ -52,6 +53,19 @@ def test_smoke_run_one_task(tmp_path):
     assert "validation_decisions" in header and "reevaluated_roots" in header
     cfg = (tmp_path / "g/cartpole/paper/seed1/config.toml").read_text()
     assert "test_episodes = 3" in cfg and "test_interval = 2" in cfg
+    # the population oracle replays the run's own test: its champion scores as in the report
+    seeds = [str(tmp_path / f"g/cartpole/paper/seed{k}") for k in (0, 1)]
+    done = subprocess.run(
+        [sys.executable, str(ORACLE), *seeds, "--episodes", "3"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    lines = [ln.split("|") for ln in done.stdout.splitlines()[2:4]]
+    for cells, run in zip(lines, rows[0]["all"]["per_run"], strict=True):
+        champion, best, worst = float(cells[4]), float(cells[5]), float(cells[7])
+        assert champion == pytest.approx(run[0], abs=0.005)
+        assert worst <= champion <= best
 
 
 @pytest.mark.slow

@@ -218,9 +218,10 @@ def test_champions_are_the_best_validated_of_each_subsets_candidates() -> None:
     assert sum(r["validated_roots"] for r in rows) >= len(st.validation)
 
 
-def test_test_episodes_never_reach_selection_or_the_champion_choice(monkeypatch) -> None:
+@pytest.mark.parametrize("options", [ON + RESAMPLE, ON + MEAN])
+def test_test_episodes_never_reach_selection_or_the_champion_choice(monkeypatch, options) -> None:
     calls: list = []
-    config = tiny(*ON, *RESAMPLE)
+    config = tiny(*options)
     ref, rows, tests = _run(config, 5, calls)
     test_seeds = set(held_out_seeds(3).tolist())
     assert {p for p, _ in calls} == {"train", "test"}

@@ -258,7 +258,14 @@ def _figure(rows: list[dict], path: Path) -> None:
     import matplotlib.pyplot as plt
 
     scenarios = list(dict.fromkeys(r["scenario"] for r in rows))
-    fig, axes = plt.subplots(1, len(scenarios), figsize=(4 * len(scenarios), 3.2), squeeze=False)
+    widths = [max(3, sum(r["scenario"] == n for r in rows)) for n in scenarios]
+    fig, axes = plt.subplots(
+        1,
+        len(scenarios),
+        figsize=(0.55 * sum(widths) + 1.5, 4.2),
+        squeeze=False,
+        gridspec_kw={"width_ratios": widths},
+    )  # one bar per setting, each as wide in every panel
     for ax, name in zip(axes[0], scenarios, strict=True):
         mine = [r for r in rows if r["scenario"] == name]
         x = range(len(mine))
@@ -272,7 +279,7 @@ def _figure(rows: list[dict], path: Path) -> None:
             ax.plot([i] * len(runs), runs, "o", ms=3, color="black", alpha=0.6)
         ax.plot([], [], "o", ms=3, color="black", alpha=0.6, label="one run")
         labels = [f"{r['setting']} (n={len(r['seeds'])})" for r in mine]
-        ax.set_xticks(list(x), labels, rotation=30, ha="right")
+        ax.set_xticks(list(x), labels, rotation=60, ha="right", fontsize=8)
         if ax is axes[0][0]:
             ax.legend(fontsize=7, loc="upper left")
         ax.set_title(name)

@@ -16,17 +16,14 @@ from mtpg.engine.compile import compile_population
 from mtpg.evolve.persist import state_from_payload, state_to_payload
 from mtpg.evolve.trainer import Trainer
 from mtpg.io.serialize import FormatError
+from tinyruns import tiny_overrides
 
-TINY = [
-    "team.root_size=12",
-    "team.n_elite=2",
-    "team.init_team_size=3",
-    "evaluation.train_episodes=2",
-    "evaluation.test_episodes=3",
-    "evaluation.test_interval=0",
-    'evaluation.tasks=["CartPole", "Pendulum"]',
-    "evaluation.resample_interval=1",  # a new block every generation
-]
+TINY = tiny_overrides(
+    evaluation__test_episodes=3,
+    evaluation__test_interval=0,
+    evaluation__tasks='["CartPole", "Pendulum"]',
+    evaluation__resample_interval=1,  # a new block every generation
+)
 
 
 def _block_score(tr: Trainer, root: int, gen: int) -> np.ndarray:

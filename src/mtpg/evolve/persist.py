@@ -98,7 +98,8 @@ def state_to_payload(state: TrainerState) -> dict[str, Any]:
 def _validation_payload(state: TrainerState) -> dict[str, Any]:
     """Validation scores, per-episode returns and block counts, each only when its option is on.
 
-    With every option off (the paper) the payload has neither key, as before they existed.
+    With every option off (the paper) the payload has none of these keys, as before they
+    existed.
     """
     out: dict[str, Any] = {}
     if state.config.evaluation.validation_episodes > 0:

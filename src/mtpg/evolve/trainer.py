@@ -299,12 +299,14 @@ class Trainer:
         )
         per_episode = returns.reshape(len(todo), len(self.task_ids), ev.train_episodes)
         for root, row in zip(todo, per_episode.mean(axis=2), strict=True):
+            if ev.resample_mean and root in survivors:  # the mean over its blocks
+                n, total = st.blocks[root]
+                st.blocks[root] = (n + 1, total + row)
+                st.scores[root] = (total + row) / (n + 1)
+                continue
+            if ev.resample_mean:
+                st.blocks[root] = (1, row)
             st.scores[root] = row
-            if ev.resample_mean:  # the mean over the blocks the root has played
-                n, total = st.blocks[root] if root in survivors else (0, None)
-                total = row if total is None else total + row
-                st.blocks[root] = (n + 1, total)
-                st.scores[root] = total / (n + 1) if n else row
         if self.config.team.parent_selection == "lexicase":
             for root, table in zip(todo, per_episode, strict=True):
                 st.returns[root] = table

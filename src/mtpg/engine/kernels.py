@@ -154,9 +154,6 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
     u_m = np.uint64(M)
     u_base = np.uint64(base)
     team = np.uint64(root)
-    # +0.0, computed from a constant register so that the compiler cannot see it is zero:
-    # zero stores of a known 0.0 are turned into a libc memset call per program run.
-    zero = W[R] - W[R]
     n_teams = 0
     n_instr = np.uint64(0)
     while True:
@@ -178,9 +175,12 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
                 bank_stamp[bank] = episode
                 if rec is not None:
                     record_reset(rec, bank, M)
-            if R == 8:  # the common size: straight-line stores
-                W[0] = W[1] = W[2] = W[3] = W[4] = W[5] = W[6] = W[7] = zero
+            if R == 8:  # the common size: one 64-byte clear (two vector stores)
+                W[0] = W[1] = W[2] = W[3] = W[4] = W[5] = W[6] = W[7] = 0.0
             else:
+                # +0.0 from a constant register, which the compiler cannot see is zero:
+                # a loop storing a known 0.0 becomes a libc memset call per program run.
+                zero = W[R] - W[R]
                 for i in range(R):
                     W[i] = zero
             lo, hi = np.uint64(prog_offsets[p]), np.uint64(prog_offsets[p + one])

@@ -48,16 +48,19 @@ def step(p: np.ndarray, s: np.ndarray, a_d: int) -> tuple[float, bool]:
     Returns:
         (reward, terminated).
     """
+    # cos and sin first: values read before a call must be kept across it (spilled to the
+    # stack and read back), values read after it need not. The arithmetic is unchanged.
+    theta = s[2]
+    costheta = np.cos(theta)
+    sintheta = np.sin(theta)
     force = bang_bang_force(a_d, s[PREV_FORCE_SLOT], p[FORCE])
     s[PREV_FORCE_SLOT] = force
-    x, x_dot, theta, theta_dot = s[0], s[1], s[2], s[3]
+    x, x_dot, theta_dot = s[0], s[1], s[3]
     masspole = p[MASSPOLE]
     length = p[LENGTH]
     total_mass = masspole + p[MASSCART]
     polemass_length = masspole * length
     tau = p[TAU]
-    costheta = np.cos(theta)
-    sintheta = np.sin(theta)
     temp = (force + polemass_length * (theta_dot * theta_dot) * sintheta) / total_mass
     thetaacc = (p[GRAVITY] * sintheta - costheta * temp) / (
         length * (4.0 / 3.0 - masspole * (costheta * costheta) / total_mass)

@@ -21,6 +21,7 @@ from mtpg.envs.core import STATE_SIZE, TASK_NAMES
 from mtpg.envs.protocol import held_out_seeds
 from mtpg.evolve.trainer import Trainer
 from mtpg.model.graph import check_invariants
+from mtpg.model.instructions import RegisterLayout
 
 EXTREME = [0.0, 1.0, -1.0, 1e-300, -1e-300, 1e10, -1e10, 1e300, -1e300, 0.5]
 
@@ -75,6 +76,16 @@ def test_decide_matches_reference_on_layered_graphs(no_memory):
     pop, roots = layered_graphs(rng, 4, teams=3, programs=10, instructions=10)
     for root in roots:
         compare_sequence(pop, root, observations(rng, 20), np.zeros(20, np.int64), no_memory)
+
+
+@pytest.mark.parametrize("n_registers", [1, 3, 4, 12])
+def test_decide_matches_reference_with_other_register_counts(n_registers):
+    # eight registers take the kernel's straight-line clear; every other count its loop
+    rng = np.random.default_rng(11)
+    layout = RegisterLayout(n_registers=n_registers, n_memory=3)
+    pop, roots = layered_graphs(rng, 3, teams=3, programs=6, instructions=12, layout=layout)
+    for root in roots:
+        compare_sequence(pop, root, observations(rng, 12), np.repeat([0, 1], 6), False)
 
 
 def test_memory_modes_differ_on_generated_graphs():

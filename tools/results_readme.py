@@ -90,7 +90,12 @@ def build(results: Path, analyze: bool = True) -> Path:
     from mtpg.analysis.runs.champions import CHAMPION_RULE
     from mtpg.analysis.runs.loading import group_runs, load_run
     from mtpg.analysis.runs.report import build_report
-    from mtpg.analysis.runs.reported_numbers import BEST_RUN_RULE, best_of, run_numbers
+    from mtpg.analysis.runs.reported_numbers import (
+        BEST_RUN_RULE,
+        best_of,
+        best_single_task,
+        run_numbers,
+    )
     from mtpg.analysis.runs.statistics_figures import STATS_NOTE, group_estimates
 
     paths = _runs(results)
@@ -115,7 +120,7 @@ def build(results: Path, analyze: bool = True) -> Path:
     (figures / "index.html").unlink(missing_ok=True)  # the PNGs are committed instead
     best = best_of([numbers[r.path] for r in tpg.runs])
     per_task, overall = group_estimates(tpg, numbers)
-    best_single = {t: max(numbers[r.path].single[t] for r in tpg.runs) for t in tasks}
+    best_single = best_single_task([numbers[r.path] for r in tpg.runs])
 
     lines = [
         "# The paper's experiment, reproduced",

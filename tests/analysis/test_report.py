@@ -13,7 +13,7 @@ from mtpg.analysis.runs import statistics_figures as plots_stats
 from mtpg.analysis.runs.champions import champion_path
 from mtpg.analysis.runs.loading import group_runs, load_run, normalise_scores, reference_best
 from mtpg.analysis.runs.report import MixedRunsWarning, build_report
-from mtpg.analysis.runs.reported_numbers import best_of, run_numbers
+from mtpg.analysis.runs.reported_numbers import best_of, best_single_task, run_numbers
 from mtpg.cli.main import main
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
 from mtpg.envs.reference import REFERENCE, measure_random, measure_time_optimal_cartcentering
@@ -148,6 +148,10 @@ def test_numbers_use_training_selection_not_test_scores(runs):
     # the best run is the one with the highest minimum normalised training score
     all_n = [run_numbers(load_run(p)) for p in runs[:2]]
     assert best_of(all_n).selection_score == max(x.selection_score for x in all_n)
+    # the shared single-task denominator (Fig. 7, results page) is the best run's per task
+    best = best_single_task(all_n)
+    for task in run.tasks:
+        assert best[task] == max(x.single[task] for x in all_n)
 
 
 def test_mixed_configurations_are_grouped_labelled_and_warned(

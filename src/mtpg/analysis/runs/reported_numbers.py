@@ -123,6 +123,17 @@ def best_of(numbers: list[RunNumbers]) -> RunNumbers:
     return max(numbers, key=lambda n: n.selection_score)
 
 
+def best_single_task(numbers: list[RunNumbers]) -> dict[str, float]:
+    """Per task, the best single-task champion's test score over ``numbers``' runs.
+
+    The shared denominator of the paper's Fig. 7 and of the results page's comparisons:
+    every experiment is measured against the same scores, so one run's weak single-task
+    champion does not inflate its own ratios.
+    """
+    tasks = numbers[0].run.tasks
+    return {t: max(n.single[t] for n in numbers) for t in tasks}
+
+
 def describe(numbers: list[RunNumbers]) -> str:
     """One line naming the champion, generation(s) and episodes behind a set of numbers."""
     gens = sorted({n.generation for n in numbers})

@@ -18,6 +18,7 @@ from mtpg.analysis.runs.reported_numbers import (
     SINGLE_RULE,
     RunNumbers,
     best_of,
+    best_single_task,
     describe,
 )
 from mtpg.envs.protocol import describe_held_out
@@ -197,7 +198,7 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
     plt = pyplot()
     ref_runs = [numbers[r.path] for r in groups[0].runs]
     tasks = ref_runs[0].run.tasks
-    single = {t: max(n.single[t] for n in ref_runs) for t in tasks}
+    single = best_single_task(ref_runs)
     bars = {}
     shown = []
     for g in groups:

@@ -1,0 +1,56 @@
+"""``tools/check_resume.py``: a committed run resumed from an earlier commit is compared."""
+
+import importlib.util
+import subprocess
+import sys
+from pathlib import Path
+
+from stopruns import SETTINGS
+
+TOOLS = Path(__file__).parents[2] / "tools"
+
+
+def _tool(name):
+    spec = importlib.util.spec_from_file_location(name, TOOLS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def _git(repo, *args):
+    return subprocess.run(["git", *args], cwd=repo, capture_output=True, text=True, check=True)
+
+
+def test_resume_from_an_earlier_commit_is_checked(tmp_path, monkeypatch, capsys):
+    for key in ("AUTHOR", "COMMITTER"):
+        monkeypatch.setenv(f"GIT_{key}_NAME", "mtpg tests")
+        monkeypatch.setenv(f"GIT_{key}_EMAIL", "tests@mtpg.invalid")
+    repo = tmp_path / "repo"
+    results = repo / "results"
+    results.mkdir(parents=True)
+    _git(repo, "init", "-q")
+    _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
+    grow = _tool("grow_results")
+    monkeypatch.setattr(grow, "PLAN", (("TPG-seed3", 3, None),))
+    argv = ["--budget", "5", "--unchecked", "--results", str(results)]
+    argv += [f"--train-arg={a}" for a in SETTINGS]
+    assert grow.main([*argv, "--generations", "5"]) == 0  # a commit at generation 5
+    assert grow.main([*argv, "--generations", "9"]) == 0  # and one at 9
+
+    check = _tool("check_resume")
+    assert check.main(["--results", str(results)]) == 0
+    out = capsys.readouterr().out
+    # from generation 5 to the next test point, 6 (test_interval 2)
+    assert "TPG-seed3: resumed 5 -> 6 from" in out and "EQUAL" in out
+
+    # a committed row that a resume does not repeat is found
+    metrics = results / "runs" / "TPG-seed3" / "metrics.csv"
+    lines = metrics.read_text().splitlines()
+    row = lines[6].split(",")  # generation 6
+    row[2] = str(int(row[2]) + 1)  # teams
+    lines[6] = ",".join(row)
+    metrics.write_text("\n".join(lines) + "\n")
+    _git(repo, "commit", "-q", "-am", "tamper")
+    assert check.main(["--results", str(results), "--generations", "2"]) == 1
+    assert "DIFFERENT at generations [6]" in capsys.readouterr().out

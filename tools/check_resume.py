@@ -17,6 +17,10 @@ timings, ``tests.csv`` value for value at the test points of the schedule. The
 generations in ``HEAD`` were run by other processes, sittings and often other commits of
 mtpg (``provenance.csv`` names them), so agreement shows that a resume from the
 repository, with the code checked out now, repeats them. Exit status 1 when any run disagrees.
+
+With ``--record`` each run's outcome replaces its row of ``results/resume_check.csv``
+(run, the commit resumed from, generations, rows compared, result, the mtpg commit that
+checked, when), which ``tools/results_readme.py`` shows on the results page.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ import subprocess
 import sys
 import tempfile
 import tomllib
+from datetime import UTC, datetime
 from pathlib import Path
 
 from mtpg.evolve.trainer import TIMING_COLUMNS
@@ -62,8 +67,38 @@ def start_point(repo: Path, run: str, final: int) -> tuple[str, int] | None:
     return None
 
 
-def check(repo: Path, run: str, k: int | None, work: Path) -> bool:
-    """Resumes one run from its newest earlier commit and compares; True when equal."""
+def mtpg_commit() -> str:
+    """The commit of the mtpg this interpreter imports (``+dirty`` with local changes)."""
+    import mtpg
+
+    top = Path(mtpg.__file__).parent
+    commit = git(top, "rev-parse", "HEAD").strip()
+    dirty = git(top, "status", "--porcelain", "--untracked-files=no", "--", ".").strip()
+    return commit + ("+dirty" if dirty else "")
+
+
+RECORD = "resume_check.csv"
+RECORD_COLUMNS = (
+    "run",
+    "resumed_from_commit",
+    "from_generation",
+    "to_generation",
+    "metrics_rows",
+    "test_rows",
+    "result",
+    "mtpg_commit",
+    "checked_utc",
+)
+
+
+def check(repo: Path, run: str, k: int | None, work: Path) -> dict[str, str] | None:
+    """Resumes one run from its newest earlier commit and compares.
+
+    Returns:
+        The run's row for :data:`RECORD` (``result`` is ``equal`` or ``different``, or
+        ``failed`` when the resume did not finish), or None when the run has no earlier
+        committed checkpoint.
+    """
     metrics_head = git(repo, "show", f"HEAD:{run}/metrics.csv")
     tests_head = git(repo, "show", f"HEAD:{run}/tests.csv")
     final = max(rows(metrics_head))
@@ -71,7 +106,7 @@ def check(repo: Path, run: str, k: int | None, work: Path) -> bool:
     name = Path(run).name
     if found is None:
         print(f"{name}: no earlier committed checkpoint to resume from")
-        return True
+        return None
     commit, g = found
     config = tomllib.loads(git(repo, "show", f"{commit}:{run}/config.toml"))
     interval = int(config["evaluation"]["test_interval"])
@@ -87,9 +122,12 @@ def check(repo: Path, run: str, k: int | None, work: Path) -> bool:
         capture_output=True,
         text=True,
     )
+    row = {"run": name, "resumed_from_commit": commit, "from_generation": str(g)}
+    row |= {"to_generation": str(target), "mtpg_commit": mtpg_commit()}
+    row["checked_utc"] = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     if done.returncode != 0:
         print(f"{name}: mtpg train --resume failed: {done.stderr.strip()[-300:]}")
-        return False
+        return row | {"metrics_rows": "0", "test_rows": "0", "result": "failed"}
     span = range(g + 1, target + 1)
     timing = frozenset(TIMING_COLUMNS)
     new_m, old_m = rows((here / "metrics.csv").read_text(), timing), rows(metrics_head, timing)
@@ -109,7 +147,18 @@ def check(repo: Path, run: str, k: int | None, work: Path) -> bool:
         f"({len(span)} metrics rows, {tested} test rows compared)",
         flush=True,
     )
-    return not bad
+    result = "different" if bad else "equal"
+    return row | {"metrics_rows": str(len(span)), "test_rows": str(tested), "result": result}
+
+
+def record(path: Path, found: list[dict[str, str]]) -> None:
+    """Replaces the checked runs' rows of the record at ``path`` (runs sorted by name)."""
+    old = list(csv.DictReader(path.open())) if path.is_file() else []
+    by_run = {r["run"]: r for r in old} | {r["run"]: r for r in found}
+    with path.open("w", newline="") as f:
+        writer = csv.DictWriter(f, RECORD_COLUMNS, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(by_run[k] for k in sorted(by_run))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -118,6 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("runs", nargs="*", help="run names (default: every run in results/runs)")
     p.add_argument("--generations", type=int, default=None, help="K (next test point)")
     p.add_argument("--results", type=Path, default=Path("results"), help="folder (results)")
+    p.add_argument("--record", action="store_true", help=f"write the outcomes to {RECORD}")
     args = p.parse_args(argv)
     results = args.results.resolve()
     repo = Path(git(results, "rev-parse", "--show-toplevel").strip())
@@ -125,11 +175,15 @@ def main(argv: list[str] | None = None) -> int:
     names = args.runs or sorted(
         Path(n).parent.name for n in git(repo, "ls-files", "--", f"{prefix}/*/config.toml").split()
     )
-    ok = True
+    found = []
     for name in names:
         with tempfile.TemporaryDirectory() as work:
-            ok &= check(repo, f"{prefix}/{name}", args.generations, Path(work))
-    return 0 if ok else 1
+            row = check(repo, f"{prefix}/{name}", args.generations, Path(work))
+        if row is not None:
+            found.append(row)
+            if args.record:  # after every run, so a stopped check keeps what it found
+                record(results / RECORD, found)
+    return 0 if all(r["result"] == "equal" for r in found) else 1
 
 
 if __name__ == "__main__":

@@ -34,6 +34,7 @@ from results_text import (  # the tool's own helper module beside it
     hierarchy_rows,
     markdown_table,
     rescore_rows,
+    resume_check_rows,
     status_rows,
 )
 
@@ -261,6 +262,19 @@ def build(results: Path, analyze: bool = True) -> Path:
     ]
     lines += markdown_table(*cost_rows(runs)) + [""]
     lines += GROWING
+    checked = results / "resume_check.csv"
+    if checked.is_file():
+        lines += [
+            "Checked on the runs themselves by `.venv/bin/python tools/check_resume.py "
+            "--record`: each run as an earlier commit holds it (its checkpoint then), "
+            "written into an empty folder as a fresh clone would hold it, resumed with the "
+            "mtpg named up to its next test point, and the rows it writes compared with "
+            "those committed since (`metrics.csv` without its timing columns, `tests.csv` "
+            "value for value):",
+            "",
+            *markdown_table(*resume_check_rows(checked)),
+            "",
+        ]
     if caught:
         lines += [f"Report warning: {w.message}" for w in caught] + [""]
     readme = results / "README.md"

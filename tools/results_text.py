@@ -222,3 +222,21 @@ def rescore_rows(runs) -> tuple[list[str], list[list[str]]]:
         ]
         rows.append([r.name, str(r.final_generation), *cells])
     return head, rows
+
+
+def resume_check_rows(path: Path) -> tuple[list[str], list[list[str]]]:
+    """The rows ``tools/check_resume.py --record`` wrote, one per run."""
+    head = ["run", "resumed from", "generations", "rows compared", "result", "by mtpg", "on"]
+    rows = [
+        [
+            r["run"],
+            r["resumed_from_commit"][:10],
+            f"{r['from_generation']} -> {r['to_generation']}",
+            f"{r['metrics_rows']} metrics, {r['test_rows']} tests",
+            r["result"],
+            r["mtpg_commit"][:10] + ("+dirty" if r["mtpg_commit"].endswith("+dirty") else ""),
+            r["checked_utc"][:10],
+        ]
+        for r in csv.DictReader(path.open())
+    ]
+    return head, rows

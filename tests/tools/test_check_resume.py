@@ -1,5 +1,6 @@
 """``tools/check_resume.py``: a committed run resumed from an earlier commit is compared."""
 
+import csv
 import importlib.util
 import subprocess
 import sys
@@ -39,10 +40,14 @@ def test_resume_from_an_earlier_commit_is_checked(tmp_path, monkeypatch, capsys)
     assert grow.main([*argv, "--generations", "9"]) == 0  # and one at 9
 
     check = _tool("check_resume")
-    assert check.main(["--results", str(results)]) == 0
+    assert check.main(["--results", str(results), "--record"]) == 0
     out = capsys.readouterr().out
     # from generation 5 to the next test point, 6 (test_interval 2)
     assert "TPG-seed3: resumed 5 -> 6 from" in out and "EQUAL" in out
+    (row,) = csv.DictReader((results / "resume_check.csv").open())
+    assert (row["from_generation"], row["to_generation"], row["result"]) == ("5", "6", "equal")
+    first_commit = _git(repo, "log", "--format=%H").stdout.split()[1]
+    assert row["resumed_from_commit"] == first_commit
 
     # a committed row that a resume does not repeat is found
     metrics = results / "runs" / "TPG-seed3" / "metrics.csv"
@@ -51,6 +56,6 @@ def test_resume_from_an_earlier_commit_is_checked(tmp_path, monkeypatch, capsys)
     row[2] = str(int(row[2]) + 1)  # teams
     lines[6] = ",".join(row)
     metrics.write_text("\n".join(lines) + "\n")
-    _git(repo, "commit", "-q", "-am", "tamper")
+    _git(repo, "commit", "-q", "-m", "tamper", "--", str(metrics))
     assert check.main(["--results", str(results), "--generations", "2"]) == 1
     assert "DIFFERENT at generations [6]" in capsys.readouterr().out

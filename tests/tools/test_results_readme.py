@@ -1,6 +1,7 @@
 """``tools/results_readme.py``: the results page and its figures, from run directories alone."""
 
 import re
+import shutil
 import sys
 from pathlib import Path
 
@@ -107,3 +108,18 @@ def test_summaries_leave_out_runs_still_growing_once_some_are_finished(
     assert "| TPG-seed3 | 2 | " in text  # still listed, at its latest test point
     assert "IQM over TPG seeds at generation 4 |" in text
     assert "Best TPG run: **TPG-seed" in text and "Best TPG run: **TPG-seed3**" not in text
+
+
+def test_the_page_shows_the_recorded_resume_check(results, tmp_path):
+    import check_resume
+
+    page = tmp_path / "results"
+    shutil.copytree(results / "runs", page / "runs")
+    row = dict.fromkeys(check_resume.RECORD_COLUMNS, "")
+    row |= {"run": "TPG-seed1", "resumed_from_commit": "a" * 40, "from_generation": "2"}
+    row |= {"to_generation": "4", "metrics_rows": "2", "test_rows": "9", "result": "equal"}
+    row |= {"mtpg_commit": "b" * 40, "checked_utc": "2026-12-03T18:00:00Z"}
+    check_resume.record(page / check_resume.RECORD, [row])
+    text = results_readme.build(page, analyze=False).read_text()
+    assert "tools/check_resume.py --record" in text
+    assert "| TPG-seed1 | aaaaaaaaaa | 2 -> 4 | 2 metrics, 9 tests | equal | bbbbbbbbbb |" in text

@@ -196,12 +196,17 @@ def ablation_rows(groups, numbers, best_single, tasks) -> tuple[list[str], list[
 RESCORE_OFFSET = 500_000
 
 
-def rescore_rows(runs) -> tuple[list[str], list[list[str]]]:
+def rescore_rows(runs) -> tuple[list[str], list[list[str]], int, int]:
     """Each run's all-task champion: its test return with a 95% interval, and a re-score.
 
     The interval is ``1.96 * std / sqrt(n)`` over the run's own ``n`` test episodes (the
     scores of ``tests.csv``); the re-score plays ``n`` other held-out episodes
-    (:data:`RESCORE_OFFSET`), which should fall inside it about 95% of the time.
+    (:data:`RESCORE_OFFSET`). Two means of independent blocks with that spread differ by
+    less than ``sqrt(2)`` half-widths about 95% of the time.
+
+    Returns:
+        The table's head and rows, the number of (run, task) cells whose re-score is
+        within ``sqrt(2)`` half-widths of the test return, and the number of cells.
     """
     from mtpg.analysis.runs.champions import champion_path
     from mtpg.evolve.testing import evaluate_graph
@@ -209,7 +214,7 @@ def rescore_rows(runs) -> tuple[list[str], list[list[str]]]:
 
     tasks = runs[0].tasks
     head = ["run", "generation", *tasks]
-    rows = []
+    rows, agree = [], 0
     for r in runs:
         pop, root, _ = load_graph(champion_path(r))
         ev = r.config.evaluation
@@ -220,8 +225,12 @@ def rescore_rows(runs) -> tuple[list[str], list[list[str]]]:
             f"{own[t].mean:.4g} ± {1.96 * own[t].std / np.sqrt(n):.2g} ({other[t].mean:.4g})"
             for t in tasks
         ]
+        agree += sum(
+            abs(own[t].mean - other[t].mean) <= np.sqrt(2) * 1.96 * own[t].std / np.sqrt(n)
+            for t in tasks
+        )
         rows.append([r.name, str(r.final_generation), *cells])
-    return head, rows
+    return head, rows, agree, len(rows) * len(tasks)
 
 
 def resume_check_rows(path: Path) -> tuple[list[str], list[list[str]]]:

@@ -80,6 +80,9 @@ def test_the_page_gives_each_champion_test_return_with_its_interval(results):
     )
     means = [float(cell.split("±")[0]) for cell in row.split("|")[3:-1]]
     assert means == [float(f"{n.test[t]:.4g}") for t in n.run.tasks]
+    # the count of re-scores within sqrt(2) half-widths is of every (run, task) cell
+    found = re.search(r"that close in (\d+) of (\d+) cells", text)
+    assert found and int(found[1]) <= int(found[2]) == 3 * len(n.run.tasks)
 
 
 def test_summaries_leave_out_runs_still_growing_once_some_are_finished(

@@ -126,3 +126,26 @@ def test_the_page_shows_the_recorded_resume_check(results, tmp_path):
     text = results_readme.build(page, analyze=False).read_text()
     assert "tools/check_resume.py --record" in text
     assert "| TPG-seed1 | aaaaaaaaaa | 2 -> 4 | 2 metrics, 9 tests | equal | bbbbbbbbbb |" in text
+
+
+def test_the_paper_s_ablation_claims_are_read_as_stated_rules():
+    from results_text import ablation_verdict
+
+    tasks = ("CartPole", "Pendulum", "MountainCarContinuous")
+
+    def vs(*values):
+        return dict(zip(tasks, values, strict=True))
+
+    assert ablation_verdict("TPG", vs(0.9, 0.86, 1.1)) == "as the paper"
+    assert ablation_verdict("TPG", vs(0.9, 0.84, 1.1)) == "below 0.85 in Pendulum"
+    assert ablation_verdict("TPG-NoXover", vs(0.8, 0.95, 1.0)) == "as the paper"
+    assert ablation_verdict("TPG-NoXover", vs(0.79, 0.95, float("nan"))) == (
+        "below 0.80 in CartPole, MountainCarContinuous"
+    )
+    assert ablation_verdict("TPG-NoMemory", vs(0.1, 0.49, 0.0)) == "as the paper"
+    assert ablation_verdict("TPG-NoMemory", vs(0.1, 0.5, 0.7)) == (
+        "0.5 or more in Pendulum, MountainCarContinuous"
+    )
+    assert ablation_verdict("TPG-NoHierarchy", vs(0.1, 0.79, 0.8)) == "as the paper"
+    assert ablation_verdict("TPG-NoHierarchy", vs(0.9, 0.2, 0.5)) == "0.8 or more in CartPole"
+    assert ablation_verdict("TPG-NoHierarchy", vs(0.1, 0.2, 0.5)) == "0.8 or more in no task"

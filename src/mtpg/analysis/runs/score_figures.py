@@ -211,8 +211,9 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
     _bars(ax, tasks, bars)
     label = groups[0].label
     ax.set_ylabel(f"normalised test score\n(0 = random, 1 = best single-task, {label})")
-    ax.set_title("Experiments: the best run's all-task champion of each")
-    ax.legend(fontsize=7)
+    ax.set_title("Experiments: the best run's all-task champion of each", pad=34)
+    # above the axes, so that no bar or its value is hidden behind it
+    ax.legend(fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
     caption = (
         f"{describe(shown)} Normalised: 0 = random play, 1 = the best single-task champion "
         f"of the {len(ref_runs)} {label} run(s) by test score (each run's best root on the "

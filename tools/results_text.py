@@ -254,14 +254,9 @@ def rescore_rows(runs) -> tuple[list[str], list[list[str]], int, int]:
         n = ev.test_episodes
         own = evaluate_graph(pop, root, list(tasks), n, 0, no_memory=ev.no_memory)
         other = evaluate_graph(pop, root, list(tasks), n, RESCORE_OFFSET, no_memory=ev.no_memory)
-        cells = [
-            f"{own[t].mean:.4g} ± {1.96 * own[t].std / np.sqrt(n):.2g} ({other[t].mean:.4g})"
-            for t in tasks
-        ]
-        agree += sum(
-            abs(own[t].mean - other[t].mean) <= np.sqrt(2) * 1.96 * own[t].std / np.sqrt(n)
-            for t in tasks
-        )
+        half = {t: 1.96 * own[t].std / np.sqrt(n) for t in tasks}
+        cells = [f"{own[t].mean:.4g} ± {half[t]:.2g} ({other[t].mean:.4g})" for t in tasks]
+        agree += sum(abs(own[t].mean - other[t].mean) <= np.sqrt(2) * half[t] for t in tasks)
         rows.append([r.name, str(r.final_generation), *cells])
     return head, rows, agree, len(rows) * len(tasks)
 

@@ -26,6 +26,16 @@ def save(fig, path: Path) -> Path:
     return Path(path)
 
 
+def title_and_legend_above(ax, title: str) -> None:
+    """Titles the axes and puts their legend between title and axes, in two columns.
+
+    For bar charts whose bars reach the top: a legend inside the axes hides bars and
+    their values.
+    """
+    ax.set_title(title, pad=34)
+    ax.legend(fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
+
+
 def finish(fig, path: Path, caption: str, legend_rows: int = 0) -> Path:
     """Adds the caption (what is shown, how chosen) under the axes and saves the figure."""
     text = "\n".join(

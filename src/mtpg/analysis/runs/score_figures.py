@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.plotting import finish, pyplot
+from mtpg.analysis.plotting import finish, pyplot, title_and_legend_above
 from mtpg.analysis.runs.loading import RunGroup, normalise_scores, reference_best
 from mtpg.analysis.runs.reported_numbers import (
     BEST_RUN_RULE,
@@ -211,9 +211,7 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
     _bars(ax, tasks, bars)
     label = groups[0].label
     ax.set_ylabel(f"normalised test score\n(0 = random, 1 = best single-task, {label})")
-    ax.set_title("Experiments: the best run's all-task champion of each", pad=34)
-    # above the axes, so that no bar or its value is hidden behind it
-    ax.legend(fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
+    title_and_legend_above(ax, "Experiments: the best run's all-task champion of each")
     caption = (
         f"{describe(shown)} Normalised: 0 = random play, 1 = the best single-task champion "
         f"of the {len(ref_runs)} {label} run(s) by test score (each run's best root on the "

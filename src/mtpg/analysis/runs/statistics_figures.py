@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.analysis.plotting import finish, pyplot
+from mtpg.analysis.plotting import finish, pyplot, title_and_legend_above
 from mtpg.analysis.runs import statistics as stats
 from mtpg.analysis.runs.loading import RunGroup
 from mtpg.analysis.runs.reported_numbers import RunNumbers, describe
@@ -84,9 +84,7 @@ def aggregate(
     ax.axhline(1, color="0.5", lw=0.8, ls=":")
     ax.set_xlabel("task")
     ax.set_ylabel("IQM of normalised test score\n(0 = random, 1 = reference best)")
-    ax.set_title("Across seeds: interquartile mean with 95% confidence intervals", pad=34)
-    # above the axes, so that no bar or its value is hidden behind it
-    ax.legend(fontsize=7, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2, frameon=False)
+    title_and_legend_above(ax, "Across seeds: interquartile mean with 95% confidence intervals")
     shown = [numbers[r.path] for g in groups for r in g.runs]
     return finish(fig, path, f"{describe(shown)} {STATS_NOTE}")
 

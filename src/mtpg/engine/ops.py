@@ -45,6 +45,80 @@ def _clamp(typingctx, v):
     return types.float64(types.float64), codegen
 
 
+#: ``pow`` may skip its overflow test (``b * ln x`` against ``LOG_BIG`` and ``LOG_TINY``)
+#: when ``|b| <= 1`` and ``x`` lies in ``[POW_SAFE_LO, POW_SAFE_HI]``: then
+#: ``|b * ln x| <= ln(1e8) < 18.5``, far inside both limits, so the test always passes.
+POW_SAFE_LO = 1e-8
+POW_SAFE_HI = 1e8
+
+
+# Short-cuts, same bits: each returns what the plain operation returns, without a
+# math-library call where the result is known (an exact zero operand, or a test whose
+# outcome is known). Proven by tests/engine/test_ops_shortcuts.py against the plain
+# operations (-0, +-BIG, the division threshold, subnormals, random values).
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_div(a: float, b: float) -> float:
+    """Protected division, before the clamp."""
+    return a if abs(b) < DIV_EPS else a / b
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_pow(a: float, b: float) -> float:
+    """Protected ``|a| ** b``, before the clamp.
+
+    ``b == 0``: ``x ** 0`` is 1 for every ``x > 0`` (``0 * ln x`` is a zero, inside the
+    limits). ``|b| <= 1`` with ``x`` in the safe range: the overflow test always passes
+    (:data:`POW_SAFE_LO`), so ``ln x`` is not computed.
+    """
+    x = abs(a)
+    if x == 0.0:
+        return 0.0
+    if b == 0.0:
+        return 1.0
+    if abs(b) <= 1.0 and POW_SAFE_LO <= x <= POW_SAFE_HI:
+        return math.pow(x, b)
+    e = b * math.log(x)
+    if e > LOG_BIG:
+        return BIG
+    if e < LOG_TINY:
+        return 0.0
+    return math.pow(x, b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_cos(b: float) -> float:
+    """``cos b``; ``cos(+-0) = 1`` exactly."""
+    return 1.0 if b == 0.0 else math.cos(b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_log(b: float) -> float:
+    """Protected ``ln |b|`` (``ln 0 := 0``)."""
+    return 0.0 if b == 0.0 else math.log(abs(b))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_exp(b: float) -> float:
+    """Protected ``exp b``, before the clamp; ``exp(+-0) = 1`` exactly."""
+    if b > LOG_BIG:
+        return BIG
+    return 1.0 if b == 0.0 else math.exp(b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_sin(b: float) -> float:
+    """``sin b``; ``sin(+-0)`` is the operand itself (the sign of zero kept)."""
+    return b if b == 0.0 else math.sin(b)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def op_tanh(b: float) -> float:
+    """``tanh b``; ``tanh(+-0)`` is the operand itself (the sign of zero kept)."""
+    return b if b == 0.0 else math.tanh(b)
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def apply_op(op: int, d: float, a: float, b: float) -> float:
     """Computes one instruction's new target value (inlined into the decision kernel).
@@ -65,31 +139,21 @@ def apply_op(op: int, d: float, a: float, b: float) -> float:
     elif op == 2:
         v = a * b
     elif op == 3:
-        v = a if abs(b) < DIV_EPS else a / b
+        v = op_div(a, b)
     elif op == 4:
-        x = abs(a)
-        if x == 0.0:
-            v = 0.0
-        else:
-            e = b * math.log(x)
-            if e > LOG_BIG:
-                v = BIG
-            elif e < LOG_TINY:
-                v = 0.0
-            else:
-                v = math.pow(x, b)
+        v = op_pow(a, b)
     elif op == 5:
-        v = math.cos(b)
+        v = op_cos(b)
     elif op == 6:
-        v = 0.0 if b == 0.0 else math.log(abs(b))
+        v = op_log(b)
     elif op == 7:
-        v = BIG if b > LOG_BIG else math.exp(b)
+        v = op_exp(b)
     elif op == 8:
         v = math.sqrt(abs(b))
     elif op == 9:
-        v = math.sin(b)
+        v = op_sin(b)
     elif op == 10:
-        v = math.tanh(b)
+        v = op_tanh(b)
     elif op == 11:
         v = b * b
     elif op == 12:

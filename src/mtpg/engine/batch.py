@@ -13,6 +13,7 @@ import numpy as np
 
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.kernels import run_jobs_parallel, run_jobs_queue
+from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_parallel, run_lanes_queue
 from mtpg.envs.episodes import draw_episodes
 from mtpg.envs.variants import task_params
 
@@ -116,6 +117,7 @@ def run_jobs(
     threads: int = 1,
     no_memory: bool = False,
     block: int = 1,
+    lanes: int = DEFAULT_LANES,
 ) -> BatchResult:
     """Plays every job ``(root, episode)`` in one compiled call.
 
@@ -132,6 +134,9 @@ def run_jobs(
         block: Jobs taken together from the queue by one thread (see
             ``run_jobs_queue``); the number of jobs per root keeps each root's episodes on
             one thread, in order. Results do not depend on it.
+        lanes: Jobs of a block played in lockstep by the lane engine
+            (:mod:`mtpg.engine.lanes`); 0 plays one job at a time with the scalar
+            kernel. Results do not depend on it.
 
     Returns:
         The per-job outcomes.
@@ -140,18 +145,26 @@ def run_jobs(
         raise ValueError(f"threads must be >= 1, got {threads}")
     if block < 1:
         raise ValueError(f"block must be >= 1, got {block}")
+    if lanes < 0:
+        raise ValueError(f"lanes must be >= 0, got {lanes}")
     out = BatchResult.zeros(len(job_roots))
     jobs = Jobs(
         np.ascontiguousarray(job_roots, dtype=np.int64),
         np.ascontiguousarray(job_episodes, dtype=np.int64),
     )
     queue = np.zeros(1, dtype=np.int64)
-    if threads == 1:
-        run_jobs_queue(queue, block, jobs, episodes, no_memory, out, cp.graph)
+    g = cp.graph
+    if threads == 1 and lanes == 0:
+        run_jobs_queue(queue, block, jobs, episodes, no_memory, out, g)
+    elif threads == 1:
+        run_lanes_queue(queue, block, lanes, jobs, episodes, no_memory, out, g)
     else:
         threads = min(threads, numba.config.NUMBA_NUM_THREADS)
         numba.set_num_threads(threads)
-        run_jobs_parallel(threads, queue, block, jobs, episodes, no_memory, out, cp.graph)
+        if lanes == 0:
+            run_jobs_parallel(threads, queue, block, jobs, episodes, no_memory, out, g)
+        else:
+            run_lanes_parallel(threads, queue, block, lanes, jobs, episodes, no_memory, out, g)
     return out
 
 
@@ -161,6 +174,7 @@ def evaluate_roots(
     episodes: Episodes,
     threads: int = 1,
     no_memory: bool = False,
+    lanes: int = DEFAULT_LANES,
 ) -> tuple[np.ndarray, BatchResult]:
     """Plays every episode of the table with every root.
 
@@ -170,6 +184,7 @@ def evaluate_roots(
         episodes: The episode table.
         threads: Numba threads.
         no_memory: Ablation switch, see :func:`run_jobs`.
+        lanes: Lane-block size, see :func:`run_jobs` (0: the scalar kernel).
 
     Returns:
         ``returns`` float64 ``[n_roots, n_episodes]`` and the flat per-job result
@@ -179,5 +194,7 @@ def evaluate_roots(
     n_ep = len(episodes.tasks)
     job_roots = np.repeat(roots, n_ep)
     job_eps = np.tile(np.arange(n_ep, dtype=np.int64), len(roots))
-    result = run_jobs(cp, job_roots, job_eps, episodes, threads, no_memory, block=max(n_ep, 1))
+    result = run_jobs(
+        cp, job_roots, job_eps, episodes, threads, no_memory, block=max(n_ep, 1), lanes=lanes
+    )
     return result.returns.reshape(len(roots), n_ep), result

@@ -32,7 +32,7 @@ import numpy as np
 from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation, Graph
 from mtpg.engine.evaluator import BackendError, BackendLost
-from mtpg.engine.kernels import run_jobs_queue
+from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_queue
 
 #: Batches per worker thread: enough to balance roots of uneven cost, few enough that the
 #: scheduler's cost per task (about 1.5 ms) stays negligible. Measured on paper-sized
@@ -102,7 +102,11 @@ def play_batch(
     """
     out = BatchResult.zeros(len(job_roots))
     queue = np.zeros(1, dtype=np.int64)
-    run_jobs_queue(queue, 1, Jobs(job_roots, job_eps), table, no_memory, out, graph)
+    jobs = Jobs(job_roots, job_eps)
+    # one queue block: the batch's jobs in lane blocks of consecutive jobs (a root's episodes)
+    run_lanes_queue(
+        queue, max(len(job_roots), 1), DEFAULT_LANES, jobs, table, no_memory, out, graph
+    )
     return out
 
 

@@ -182,6 +182,7 @@ def write_test_graphs(run_path: Path, trainer: Trainer, rows: list[dict[str, Any
     state, cfg = trainer.state, trainer.config
     tasks = cfg.evaluation.tasks
     folder = run_path / TESTS_DIR / f"gen-{state.generation:06d}"
+    bodies: dict = {}  # a champion of several subsets is rendered once
     for k, row in enumerate(rows):
         names = trainer.subset_names(k)
         if len(names) not in (1, len(tasks)):
@@ -194,7 +195,8 @@ def write_test_graphs(run_path: Path, trainer: Trainer, rows: list[dict[str, Any
             "no_memory": cfg.evaluation.no_memory,
         }
         folder.mkdir(parents=True, exist_ok=True)
-        save_graph(folder / champion_filename(names), state.population, int(row["root"]), meta)
+        path = folder / champion_filename(names)
+        save_graph(path, state.population, int(row["root"]), meta, bodies)
 
 
 def champion_graphs(trainer: Trainer) -> dict[tuple[str, ...], tuple[Any, int, dict[str, Any]]]:

@@ -9,6 +9,7 @@ JSON: ``json.loads`` gives back exactly the object written.
 from __future__ import annotations
 
 import json
+from json.encoder import encode_basestring_ascii
 from typing import Any
 
 #: Objects of scalars (or scalar lists) whose one-line form is at most this long are written inline.
@@ -19,6 +20,27 @@ def _is_scalar(value: Any) -> bool:
     return value is None or isinstance(value, bool | int | float | str)
 
 
+def _scalar_text(value: Any) -> str:
+    """``json.dumps(value, allow_nan=False)`` of a scalar, without its per-call set-up.
+
+    The exact types take the encoder's own conversions (``int.__repr__``,
+    ``float.__repr__``, ``encode_basestring_ascii``); subclasses go to ``json.dumps``.
+    """
+    kind = type(value)
+    if kind is int:
+        return int.__repr__(value)
+    if kind is float:
+        if value != value or value in (_INF, -_INF):
+            return json.dumps(value, allow_nan=False)  # raises ValueError as it would
+        return float.__repr__(value)
+    if kind is str:
+        return encode_basestring_ascii(value)
+    return json.dumps(value, allow_nan=False)
+
+
+_INF = float("inf")
+
+
 def _is_flat(value: Any) -> bool:
     """A scalar, or a list of non-string scalars (written on one line anyway)."""
     if isinstance(value, list | tuple):
@@ -26,9 +48,25 @@ def _is_flat(value: Any) -> bool:
     return _is_scalar(value)
 
 
+class Encoded:
+    """A value already rendered by :func:`encode_at` at the level where it is placed."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+
+def encode_at(value: Any, level: int, indent: int = 2) -> Encoded:
+    """Renders ``value`` as it appears nested at ``level`` (for a document that reuses it)."""
+    return Encoded(_encode(value, level, indent))
+
+
 def _encode(value: Any, level: int, indent: int) -> str:
+    if type(value) is Encoded:
+        return value.text
     if _is_scalar(value):
-        return json.dumps(value, allow_nan=False)
+        return _scalar_text(value)
     pad = " " * (indent * (level + 1))
     end = " " * (indent * level)
     if isinstance(value, dict):
@@ -38,7 +76,7 @@ def _encode(value: Any, level: int, indent: int) -> str:
         for key, item in value.items():
             if not isinstance(key, str):
                 raise TypeError(f"JSON object keys must be strings, got {key!r}")
-            items.append(f"{json.dumps(key)}: {_encode(item, level + 1, indent)}")
+            items.append(f"{encode_basestring_ascii(key)}: {_encode(item, level + 1, indent)}")
         flat = "{" + ", ".join(items) + "}"
         if all(_is_flat(v) for v in value.values()) and len(flat) <= INLINE_WIDTH:
             return flat
@@ -46,6 +84,8 @@ def _encode(value: Any, level: int, indent: int) -> str:
     if isinstance(value, list | tuple):
         if not value:
             return "[]"
+        if all(type(v) is int for v in value):  # the common flat row, rendered directly
+            return "[" + ", ".join(map(int.__repr__, value)) + "]"
         items = [_encode(item, level + 1, indent) for item in value]
         if _is_flat(value):
             return "[" + ", ".join(items) + "]"

@@ -413,9 +413,11 @@ def write_champions(
     directory = RunDir(Path(run_dir)).champions
     directory.mkdir(parents=True, exist_ok=True)
     written = []
+    bodies: dict = {}  # each distinct champion rendered once (one population per call)
     for tasks, (pop, root, meta) in champions.items():
         path = directory / champion_filename(tasks)
-        save_graph(path, pop, root, {"tasks": list(canonical_tasks(tasks)), **(meta or {})})
+        meta = {"tasks": list(canonical_tasks(tasks)), **(meta or {})}
+        save_graph(path, pop, root, meta, bodies.setdefault(id(pop), {}))
         written.append(path)
     return written
 

@@ -25,7 +25,7 @@ import numpy as np
 from mtpg.envs.core import N_OBS
 from mtpg.io._atomic import atomic_write_bytes
 from mtpg.io._bounded import MAX_GRAPH_BYTES, TooLargeError, check_depth, limit, read_file_bounded
-from mtpg.io._readable import dumps_readable
+from mtpg.io._readable import Encoded, dumps_readable, encode_at
 from mtpg.model.graph import (
     N_ACTIONS,
     InvariantError,
@@ -244,13 +244,16 @@ def population_from_dict(d: Any) -> Population:
 # --------------------------------------------------------------------------- graph
 
 
-def graph_to_dict(pop: Population, root_id: int, meta: dict[str, Any] | None = None) -> dict:
+def graph_to_dict(
+    pop: Population, root_id: int, meta: dict[str, Any] | None = None, body: bool = True
+) -> dict:
     """Serializes the program graph rooted at one team, for people and for reloading.
 
     Args:
         pop: The population holding the graph.
         root_id: Id of the root team.
         meta: JSON-native facts to store alongside (task scores, generation, seed ...).
+        body: False leaves out ``teams`` and ``programs`` (for :func:`graph_text`'s cache).
 
     Returns:
         A JSON-native dict: ``format``, ``version``, ``root``, ``layout``, ``meta``,
@@ -264,36 +267,42 @@ def graph_to_dict(pop: Population, root_id: int, meta: dict[str, Any] | None = N
         raise ValueError(f"root team {root_id} is not in the population")
     if meta is not None and not isinstance(meta, dict):
         raise ValueError(f"meta must be a dict, got {type(meta).__name__}")
-    team_ids = pop.reachable(root_id)
-    prog_ids = list(dict.fromkeys(pid for tid in team_ids for pid in pop.teams[tid].programs))
-    programs = []
-    for pid in prog_ids:
-        p = pop.programs[pid]
-        action = {"atomic": int(p.atomic_action)} if p.is_atomic else {"team": int(p.action)}
-        programs.append(
-            {
-                "id": int(pid),
-                "action": action,
-                "bank": int(p.bank),
-                "instructions": _code(p.instructions),
-                "code": disassemble(p.instructions, pop.layout),
-            }
-        )
-    return {
+    head = {
         "format": GRAPH_FORMAT,
         "version": GRAPH_VERSION,
         "root": int(root_id),
         "layout": _layout_dict(pop.layout),
         "meta": dict(meta or {}),
-        "teams": [
-            {
-                "id": int(tid),
-                "programs": [int(x) for x in pop.teams[tid].programs],
-                "birth": int(pop.teams[tid].birth),
-            }
-            for tid in team_ids
-        ],
-        "programs": programs,
+    }
+    if not body:
+        return head
+    team_ids = pop.reachable(root_id)
+    return {
+        **head,
+        "teams": [_team_dict(pop, tid) for tid in team_ids],
+        "programs": [_program_dict(pop, pid) for pid in _graph_programs(pop, team_ids)],
+    }
+
+
+def _graph_programs(pop: Population, team_ids: list[int]) -> list[int]:
+    """The programs of the teams, in order of first use."""
+    return list(dict.fromkeys(pid for tid in team_ids for pid in pop.teams[tid].programs))
+
+
+def _team_dict(pop: Population, tid: int) -> dict:
+    team = pop.teams[tid]
+    return {"id": int(tid), "programs": [int(x) for x in team.programs], "birth": int(team.birth)}
+
+
+def _program_dict(pop: Population, pid: int) -> dict:
+    p = pop.programs[pid]
+    action = {"atomic": int(p.atomic_action)} if p.is_atomic else {"team": int(p.action)}
+    return {
+        "id": int(pid),
+        "action": action,
+        "bank": int(p.bank),
+        "instructions": _code(p.instructions),
+        "code": disassemble(p.instructions, pop.layout),
     }
 
 
@@ -371,7 +380,11 @@ def graph_from_dict(d: Any) -> tuple[Population, int]:
 
 
 def save_graph(
-    path: str | os.PathLike[str], pop: Population, root_id: int, meta: dict | None = None
+    path: str | os.PathLike[str],
+    pop: Population,
+    root_id: int,
+    meta: dict | None = None,
+    bodies: dict[int, dict[str, Encoded]] | None = None,
 ) -> None:
     """Writes one program graph as a readable JSON file, atomically.
 
@@ -380,17 +393,54 @@ def save_graph(
         pop: The population holding the graph.
         root_id: Id of the root team.
         meta: JSON-native facts to store alongside.
+        bodies: A cache of rendered graphs shared by the files of one commit
+            (:func:`graph_text`).
 
     Raises:
         FormatError: When ``meta`` cannot be written as JSON (naming the file).
         OSError: When the file cannot be written.
     """
-    data = graph_to_dict(pop, root_id, meta)
     try:
-        text = dumps_readable(data)
+        text = graph_text(pop, root_id, meta, bodies)
     except (TypeError, ValueError) as exc:
         raise FormatError(f"{path}: cannot write graph: {exc}") from exc
     atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def graph_text(
+    pop: Population,
+    root_id: int,
+    meta: dict | None = None,
+    bodies: dict[int, dict[str, Encoded]] | None = None,
+) -> str:
+    """The text of a graph file: ``dumps_readable(graph_to_dict(pop, root_id, meta))``.
+
+    Args:
+        pop: The population holding the graph.
+        root_id: Id of the root team.
+        meta: JSON-native facts to store alongside.
+        bodies: A cache of rendered graphs by root, valid for one unchanged ``pop`` (a
+            commit writes one file per task subset, many of them of the same champion:
+            each distinct graph is then rendered once). None: no cache.
+
+    Returns:
+        The file's text.
+    """
+    if bodies is None:
+        return dumps_readable(graph_to_dict(pop, root_id, meta))
+    data = graph_to_dict(pop, root_id, meta, body=False)  # checks root and meta
+    if root_id not in bodies:
+        team_ids = pop.reachable(root_id)
+        done = bodies.setdefault(-1, {})  # programs rendered for other graphs: shared
+        programs = []
+        for pid in _graph_programs(pop, team_ids):
+            if pid not in done:
+                done[pid] = encode_at(_program_dict(pop, pid), 2)
+            programs.append(done[pid])
+        teams = [_team_dict(pop, tid) for tid in team_ids]
+        bodies[root_id] = {"teams": encode_at(teams, 1), "programs": encode_at(programs, 1)}
+    data.update(bodies[root_id])
+    return dumps_readable(data)
 
 
 def load_graph(path: str | os.PathLike[str]) -> tuple[Population, int, dict[str, Any]]:

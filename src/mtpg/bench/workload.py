@@ -24,6 +24,7 @@ import numpy as np
 
 from mtpg.engine.batch import BatchResult, Episodes, run_jobs
 from mtpg.engine.compile import CompiledPopulation, compile_population
+from mtpg.engine.lanes import DEFAULT_LANES
 from mtpg.engine.workload import layered_graphs
 from mtpg.envs import CARTPOLE
 from mtpg.model.graph import Population
@@ -164,19 +165,27 @@ class DriveResult:
         return int(self.result.steps.sum())
 
 
-def drive(work: Workload, threads: int = 1) -> DriveResult:
+def drive(work: Workload, threads: int = 1, lanes: int = DEFAULT_LANES) -> DriveResult:
     """Plays the whole workload once with the engine's batch kernel.
 
     Args:
         work: The workload.
         threads: Numba threads (1: the serial kernel, no thread pool).
+        lanes: Lane-block size of :func:`~mtpg.engine.batch.run_jobs` (0: the scalar
+            kernel, one job at a time).
 
     Returns:
         The per-job outcomes, the wall time and the process CPU time.
     """
     c0, t0 = time.process_time(), time.perf_counter()
     result = run_jobs(
-        work.cp, work.job_roots, work.job_episodes, work.pool, threads, block=work.episodes
+        work.cp,
+        work.job_roots,
+        work.job_episodes,
+        work.pool,
+        threads,
+        block=work.episodes,
+        lanes=lanes,
     )
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     return DriveResult(result, seconds, cpu)

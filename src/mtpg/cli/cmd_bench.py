@@ -64,6 +64,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default="-O2 -march=native",
         help="flags of a second C build reported beside it ('-O2 -march=native'; '' for none)",
     )
+    eng.add_argument(
+        "--late",
+        metavar="RUN_DIR",
+        help="instead, the late-generation workload: every root of RUN_DIR's last checkpoint"
+        " on its training episodes (all its tasks), lane engine against the scalar kernel,"
+        " interleaved, one thread, process CPU time",
+    )
+    eng.add_argument(
+        "--lanes", type=int, default=32, help="lane-block size of --late (32, the engine's)"
+    )
     eng.set_defaults(func=run)
     bench.set_defaults(func=lambda _args: _help(bench))
 
@@ -75,6 +85,32 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 def _fmt(value: float | None, unit: str = "") -> str:
     return "n/a" if value is None else f"{value:,.0f}{unit}"
+
+
+def _run_late(args: argparse.Namespace, log) -> int:
+    """``mtpg bench engine --late RUN_DIR``: prints the summary and the JSON line."""
+    from mtpg.bench.engine import machine_info
+    from mtpg.bench.late import late_benchmark
+
+    try:
+        r = late_benchmark(args.late, args.repeats, args.lanes, log)
+    except (OSError, ValueError) as exc:  # config, run directory and checkpoint errors
+        raise SystemExit(f"mtpg bench engine: {exc}") from None
+    m = machine_info()
+    r["machine"] = m
+    print(
+        f"\nmtpg engine, late-generation workload ({m['cpu']}, numba {m['numba']})\n"
+        f"  workload      {r['roots']} roots of {r['run']} at generation {r['generation']},"
+        f" {r['episodes_per_root']} training episodes each: {r['decisions']:,} decisions,"
+        f" {r['teams_per_decision']:.2f} teams and {r['instructions_per_decision']:.1f}"
+        " instructions per decision\n"
+        f"  scalar        {_fmt(r['scalar_cpu_decisions_per_s'])} decisions per CPU second\n"
+        f"  lanes ({r['lanes']})    {_fmt(r['lanes_cpu_decisions_per_s'])} decisions per CPU"
+        f" second: {r['lanes_vs_scalar']:.2f}x the scalar kernel (median of {r['repeats']}"
+        " interleaved rounds, every job checked identical)"
+    )
+    print(json.dumps(r))
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
@@ -90,6 +126,9 @@ def run(args: argparse.Namespace) -> int:
 
     def log(msg: str) -> None:
         print(msg, flush=True)
+
+    if args.late:
+        return _run_late(args, log)
 
     r = benchmark(
         graphs=args.graphs,

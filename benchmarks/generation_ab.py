@@ -36,7 +36,9 @@ ROOT = Path(__file__).resolve().parent.parent
 TIMING = tuple(TIMING_COLUMNS)
 
 
-def resume(python: str, run: Path, generations: int, folder: Path) -> tuple[float, list, list]:
+def resume(
+    python: str, run: Path, generations: int, folder: Path, extra: tuple[str, ...] = ()
+) -> tuple[float, list, list]:
     """Resumes a fresh copy of ``run``; returns CPU seconds and the new rows."""
     copy = folder / run.name
     shutil.copytree(run, copy)
@@ -55,6 +57,7 @@ def resume(python: str, run: Path, generations: int, folder: Path) -> tuple[floa
             "1",
             "--generations",
             str(last + generations),
+            *extra,
         ],
         check=True,
     )
@@ -83,13 +86,30 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--run", default=str(ROOT / "results/runs/TPG-seed3"))
     ap.add_argument("--generations", type=int, default=10)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="SECTION.FIELD=VALUE",
+        help="a resumable change passed to both resumes (e.g. checkpoint_interval=5)",
+    )
+    ap.add_argument(
+        "--warm-up",
+        action="store_true",
+        help="first resume one generation with each side, untimed (compiles the kernels)",
+    )
     args = ap.parse_args(argv)
+    extra = [a for s in args.set for a in ("--set", s)]
     run = Path(args.run)
+    if args.warm_up:
+        for python in (args.baseline, args.current):
+            with tempfile.TemporaryDirectory() as w:
+                resume(python, run, 1, Path(w), tuple(extra))
     ratios = []
     for k in range(args.rounds):
         with tempfile.TemporaryDirectory() as a, tempfile.TemporaryDirectory() as b:
-            base = resume(args.baseline, run, args.generations, Path(a))
-            cur = resume(args.current, run, args.generations, Path(b))
+            base = resume(args.baseline, run, args.generations, Path(a), tuple(extra))
+            cur = resume(args.current, run, args.generations, Path(b), tuple(extra))
         if base[1:] != cur[1:]:
             print(f"round {k + 1}: the two resumes wrote different rows", file=sys.stderr)
             return 1

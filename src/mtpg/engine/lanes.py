@@ -277,7 +277,7 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                         lane = grp[k]
                         visited[u_team * L + lane] = stamp
                         n_team[lane] += 1
-                        best_p[lane] = -1
+                        best[lane] = -np.inf
                     team_ins = 0
                     for kk in range(
                         np.uint64(team_offsets[u_team]), np.uint64(team_offsets[u_team + 1])
@@ -309,15 +309,22 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                             lane_op(Wf, op, ud, ua, ub, grp, n)
                         team_ins += prog_count[p]
                         act = prog_action[p]
-                        u_act = np.uint64(act) if act >= 0 else np.uint64(0)
-                        for k in range(n):
-                            lane = grp[k]
-                            bid = Wf[lane]
-                            if (act < 0 or visited[u_act * L + lane] != stamp) and (
-                                best_p[lane] < 0 or bid > best[lane]
-                            ):
-                                best[lane] = bid
-                                best_p[lane] = np.int64(p)
+                        # bids are finite, so starting from -inf the first eligible
+                        # program wins and a later one only with a higher bid (ties: the
+                        # earlier), as in the scalar kernel
+                        if act < 0:
+                            for k in range(n):
+                                lane = grp[k]
+                                if Wf[lane] > best[lane]:
+                                    best[lane] = Wf[lane]
+                                    best_p[lane] = np.int64(p)
+                        else:
+                            u_act = np.uint64(act) * L
+                            for k in range(n):
+                                lane = grp[k]
+                                if visited[u_act + lane] != stamp and Wf[lane] > best[lane]:
+                                    best[lane] = Wf[lane]
+                                    best_p[lane] = np.int64(p)
                     for k in range(n):
                         lane = grp[k]
                         n_ins[lane] += team_ins

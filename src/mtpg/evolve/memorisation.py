@@ -120,9 +120,11 @@ class TaskProbe:
         fresh_noise: Mean return on (b), every redraw together.
         test: Mean return on (c), the held-out episodes.
         redraw_means: Mean return of each redraw of (b).
-
-    Means are exact (:func:`exact_mean`).
         single: The run's single-task champion's test score (NaN: none known).
+
+    (a), (c) and each redraw's mean are means as the trainer and ``tests.csv`` take them;
+    (b) is the exact mean of the redraws' means (:func:`exact_mean`), so a task whose
+    noise changes nothing has (b) equal to (a) to the last bit.
     """
 
     task: str
@@ -164,8 +166,7 @@ class TaskProbe:
 def exact_mean(values: np.ndarray) -> float:
     """The mean of ``values`` rounded once from its exact rational value.
 
-    So blocks of equal returns have equal means whatever their number: (b) of a task
-    whose noise changes nothing equals (a) to the last bit.
+    So equal values have their value as mean, whatever their number.
     """
     values = np.asarray(values, dtype=np.float64).ravel()
     return float(sum(map(Fraction, values.tolist())) / len(values))
@@ -222,10 +223,10 @@ def probe_graph(
         t: TaskProbe(
             t,
             observes_noise(t),
-            exact_mean(train[i]),
-            exact_mean(fresh[i]),
-            exact_mean(test[i]),
-            tuple(exact_mean(row) for row in per_redraw[i]),
+            float(train[i].mean()),
+            exact_mean(np.array([row.mean() for row in per_redraw[i]])),
+            float(test[i].mean()),
+            tuple(float(row.mean()) for row in per_redraw[i]),
             float((single or {}).get(t, float("nan"))),
         )
         for i, t in enumerate(tasks)

@@ -326,27 +326,40 @@ def _redraw_scores(p: TaskProbe, pick: str) -> list[float]:
     return [float(normalise(resolve(p.task), v)) for v in p.redraw_means]
 
 
-def probe_html(named: list[tuple[str, Probe]]) -> str:
-    """The report's memorisation section: one row per run, (a) / (b) / (c) per task."""
+def probe_html(named: list[tuple[str, str, Probe]]) -> str:
+    """The report's memorisation section: one row per (experiment, run, probe)."""
     if not named:
         return ""
-    tasks = list(named[0][1].tasks)
+    first = named[0][2]
+    tasks = list(first.tasks)
     head = "".join(f"<th>{html.escape(t)}</th>" for t in tasks)
     rows = ""
-    for name, probe in named:
+    for group, name, probe in named:
+        seeds = _seeds(probe.train_seeds)
+        if probe.resample_interval > 0:
+            seeds = f"block {probe.block}: {seeds}"
         cells = ""
         for t in tasks:
             s = probe.tasks[t].normalised()
             cells += f"<td>{s['train']:.2f} / {s['fresh_noise']:.2f} / {s['test']:.2f}</td>"
-        rows += f"<tr><td>{html.escape(name)}</td><td>{probe.generation}</td>{cells}</tr>"
-    first = named[0][1]
-    sets = "; ".join(html.escape(line) for line in first.describe_sets())
+        rows += (
+            f"<tr><td>{html.escape(group)}</td><td>{html.escape(name)}</td>"
+            f"<td>{probe.generation}</td>"
+            f"<td>{html.escape(seeds)}</td>{cells}</tr>"
+        )
     return (
         "<h2>Memorisation probe: training episodes, fresh noise, held-out episodes</h2>"
-        "<p>Each run's all-task champion, normalised (0 = random play, 1 = reference best) "
-        f"on (a) / (b) / (c). For the first run: {sets}. (a) minus (b) is what the "
-        "training noise was worth (0 where the task does not observe it); (b) minus (c) "
-        "what the training start states were worth. <code>mtpg probe RUN_DIR</code> prints "
-        "the same with mean returns and the drops.</p>"
-        f"<table><tr><th>run</th><th>generation</th>{head}</tr>{rows}</table>"
+        "<p>Each run's all-task champion, normalised (0 = random play, 1 = reference best), "
+        "on (a) / (b) / (c): (a) the training episodes it was last trained on (their seeds "
+        "in the third column; a block of redrawn episodes in a run with "
+        "<code>evaluation.resample_interval</code>), (b) the same start states with only the "
+        f"U[0, 1] noise input redrawn {first.redraws} times (noise seed {first.noise_seed}), "
+        "(c) the run's held-out test episodes. (a) minus (b) is what the training noise was "
+        "worth (exactly 0 where the task does not observe it: "
+        + html.escape(", ".join(t for t in tasks if not first.tasks[t].observes_noise) or "none")
+        + "); (b) minus (c) what the training start states were worth. "
+        "<code>mtpg probe RUN_DIR</code> prints the same with mean returns, the drops and "
+        "the spread over redraws.</p>"
+        "<table><tr><th>experiment</th><th>run</th><th>generation</th><th>(a) seeds</th>"
+        f"{head}</tr>{rows}</table>"
     )

@@ -277,3 +277,13 @@ def test_report_has_the_memorisation_probe_of_every_run(runs, report, capsys):
             assert rows[path.name][k + 2] == " / ".join(f"{v:.2f}" for v in sets)
             assert row["test"]["normalised"] == n.normalised[task]  # the report's own test
         assert rows[path.name][:2] == [str(n.generation), "0..1"]  # (a): two training episodes
+
+
+def test_training_scores_of_a_resampled_run_are_on_its_last_block(tmp_path):
+    out = tmp_path / "robust"
+    args = tiny_args(n_elite=3, evaluation__test_episodes=3, evaluation__resample_interval=1)
+    assert main(["train", *args, "--generations", "3", "--seed", "2", "--out", str(out)]) == 0
+    run = load_run(out)
+    _, _, meta = load_graph(out / "champions" / "CartPole+CartCentering.json")
+    assert meta["generation"] == run.final_generation == 3
+    assert run_numbers(run).train == meta["train_scores"]  # block 2, not seeds 0..1

@@ -281,7 +281,8 @@ def probe_text(probe: Probe) -> list[str]:
         f"{probe.target}: graph {probe.graph}, generation {probe.generation}, root team "
         f"{probe.root}, {probe.teams} teams; {memory}",
         *probe.describe_sets(),
-        "normalised: 0 = random play, 1 = reference best; " + DROPS_TEXT,
+        "normalised: 0 = random play, 1 = reference best; noise: whether the task observes "
+        "the noise input; " + DROPS_TEXT,
         "",
     ]
     head = (

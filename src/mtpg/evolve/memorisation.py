@@ -59,6 +59,13 @@ def training_block(config: RunConfig, generation: int) -> int:
 
     As the trainer: with ``evaluation.resample_interval = G``, generations 1..G play block
     0, G+1..2G block 1, and so on.
+
+    Args:
+        config: The run's configuration.
+        generation: A generation of the run (1, 2, ...).
+
+    Returns:
+        The block number.
     """
     interval = config.evaluation.resample_interval
     return (max(generation, 1) - 1) // interval if interval > 0 else 0
@@ -70,6 +77,13 @@ def champion_training_seeds(config: RunConfig, generation: int) -> np.ndarray:
     Every surviving root is scored again when a block starts, so every root alive at
     ``generation`` was last scored on that generation's block (with
     ``evaluation.resample_mean`` its selection score also averages earlier blocks).
+
+    Args:
+        config: The run's configuration.
+        generation: The generation the champion was chosen at.
+
+    Returns:
+        int64 ``[train_episodes]`` seeds.
     """
     ev = config.evaluation
     block = training_block(config, generation)
@@ -86,6 +100,15 @@ def fresh_noise_episodes(
     U[0, 1] values drawn by ``default_rng(SeedSequence(noise_seed, spawn_key=(
     NOISE_SPAWN_TAG, r, crc32(task name), seeds[k])))``: independent of the other tasks,
     redraws and episodes, and of everything a run draws.
+
+    Args:
+        tasks: Task names.
+        seeds: int64 seeds of the episodes whose start states are kept.
+        noise_seed: Seed of the redrawn noise (>= 0).
+        redraws: Redraws of every episode's noise (>= 1).
+
+    Returns:
+        The episode table, ``len(tasks) * redraws * len(seeds)`` rows.
 
     Raises:
         ValueError: If ``noise_seed`` is negative or ``redraws`` < 1.

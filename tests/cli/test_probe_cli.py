@@ -158,3 +158,12 @@ def test_a_graph_outside_a_run_is_refused(run, tmp_path, capsys):
     assert main(["probe", str(lone)]) == 2
     assert "not inside a run directory" in capsys.readouterr().err
     assert main(["probe", str(tmp_path / "missing")]) == 2
+
+
+def test_a_probe_too_large_for_memory_is_refused(run, capsys, monkeypatch):
+    import mtpg.limits
+
+    monkeypatch.setattr(mtpg.limits, "available_memory", lambda: 1 << 20)
+    capsys.readouterr()
+    assert main(["probe", str(run), "--redraws", "1000"]) == 2
+    assert "--redraws or --episodes: 4000 episodes need" in capsys.readouterr().err

@@ -166,8 +166,10 @@ def probe_target(
         ValueError: For a task the run did not train on, or a graph without a generation.
     """
     from mtpg.analysis.runs.champions import run_champion, tested_run
+    from mtpg.envs.variants import resolve, spec_of
     from mtpg.io.runconfig import read_run_config
     from mtpg.io.serialize import load_graph
+    from mtpg.limits import BudgetError, check_evaluation_fits
 
     target = Path(target)
     if not target.exists():
@@ -194,6 +196,11 @@ def probe_target(
                 pass
     seeds = champion_training_seeds(config, generation)
     episodes = ev.test_episodes if test_episodes is None else test_episodes
+    longest = max(spec_of(resolve(t)).max_steps for t in chosen)
+    try:
+        check_evaluation_fits(len(chosen) * max(len(seeds) * redraws, episodes), longest)
+    except BudgetError as exc:
+        raise BudgetError(str(exc).replace("--episodes:", "--redraws or --episodes:", 1)) from None
     scores = probe_graph(
         pop,
         root,

@@ -258,3 +258,32 @@ def test_report_page_opens_in_headless_chromium(report, tmp_path):
     )
     assert res.returncode == 0, res.stderr
     assert shot.is_file() and shot.stat().st_size > 10_000
+
+
+def test_report_has_the_memorisation_probe_of_every_run(runs, report, capsys):
+    page = report.read_text()
+    title = "Memorisation probe: training episodes, fresh noise, held-out episodes"
+    rows = _cells(page, title)
+    assert sorted(rows) == sorted(p.name for p in runs)
+    for path in runs:
+        capsys.readouterr()
+        assert main(["probe", str(path), "--json"]) == 0
+        data = json.loads(capsys.readouterr().out)
+        run = load_run(path)
+        n = run_numbers(run)
+        for k, task in enumerate(run.tasks):
+            row = data["tasks"][task]
+            sets = [row[s]["normalised"] for s in ("train", "fresh_noise", "test")]
+            assert rows[path.name][k + 2] == " / ".join(f"{v:.2f}" for v in sets)
+            assert row["test"]["normalised"] == n.normalised[task]  # the report's own test
+        assert rows[path.name][:2] == [str(n.generation), "0..1"]  # (a): two training episodes
+
+
+def test_training_scores_of_a_resampled_run_are_on_its_last_block(tmp_path):
+    out = tmp_path / "robust"
+    args = tiny_args(n_elite=3, evaluation__test_episodes=3, evaluation__resample_interval=1)
+    assert main(["train", *args, "--generations", "3", "--seed", "2", "--out", str(out)]) == 0
+    run = load_run(out)
+    _, _, meta = load_graph(out / "champions" / "CartPole+CartCentering.json")
+    assert meta["generation"] == run.final_generation == 3
+    assert run_numbers(run).train == meta["train_scores"]  # block 2, not seeds 0..1

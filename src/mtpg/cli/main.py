@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "mtpg.cli.cmd_bench",
     "mtpg.cli.cmd_train",
     "mtpg.cli.cmd_evaluate",
+    "mtpg.cli.cmd_probe",
     "mtpg.cli.cmd_report",
     "mtpg.cli.cmd_experiment",
     "mtpg.cli.cmd_show",

@@ -18,7 +18,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from mtpg.analysis.runs.loading import RunData, load_run
-from mtpg.envs.protocol import training_seeds
 from mtpg.envs.variants import resolve
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, RunDir, champion_filename
@@ -74,15 +73,22 @@ def single_task_scores(run: RunData, tasks: tuple[str, ...] | list[str]) -> dict
 def training_scores(run: RunData, path: Path) -> dict[str, float]:
     """Mean training return per task of a graph file, replayed on the run's training episodes.
 
-    Deterministic, so equal to the score selection used; recomputed rather than read so
-    that it does not depend on what a graph file's metadata holds.
+    The episodes are those the graph was last scored on at its generation
+    (:func:`mtpg.evolve.memorisation.champion_training_seeds`: the run's fixed training
+    episodes, or the block of a run that redraws them). Deterministic, so equal to the
+    score selection used (with ``evaluation.resample_mean``, to its last block's part);
+    recomputed rather than read so that it does not depend on what a graph file's metadata
+    holds.
     """
+    from mtpg.evolve.memorisation import champion_training_seeds
     from mtpg.evolve.testing import play_episodes
     from mtpg.io.serialize import load_graph
 
-    pop, root, _ = load_graph(path)
+    pop, root, meta = load_graph(path)
     ev = run.config.evaluation
+    generation = int(meta.get("generation", run.final_generation))
+    seeds = champion_training_seeds(run.config, generation)
     ids = [resolve(t) for t in run.tasks]
-    played = play_episodes(pop, [root], ids, training_seeds(ev.train_episodes), ev.no_memory)
+    played = play_episodes(pop, [root], ids, seeds, ev.no_memory)
     means = played.returns[0].mean(axis=1)
     return {t: float(m) for t, m in zip(run.tasks, means, strict=True)}

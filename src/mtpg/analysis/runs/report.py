@@ -1,7 +1,8 @@
 """``mtpg report``: section 5's figures and statistics across seeds, PNGs plus one HTML page.
 
 Every number comes from :mod:`mtpg.analysis.runs.reported_numbers` (the same definitions
-``mtpg evaluate`` uses); runs are grouped by configuration
+``mtpg evaluate`` uses) or, for the memorisation probe of every run's all-task champion,
+:mod:`mtpg.analysis.runs.memorisation` (as ``mtpg probe``); runs are grouped by configuration
 (:func:`mtpg.analysis.runs.loading.group_runs`) and a mixture of configurations beyond the
 ablation switches raises :class:`MixedRunsWarning`.
 """
@@ -19,6 +20,7 @@ from mtpg.analysis import html as pages
 from mtpg.analysis.runs import score_figures, statistics_figures
 from mtpg.analysis.runs.hierarchical_complexity import subset_complexity
 from mtpg.analysis.runs.loading import RunData, RunGroup, group_runs, load_run, reference_best
+from mtpg.analysis.runs.memorisation import probe_html, probe_target
 from mtpg.analysis.runs.reported_numbers import (
     BEST_RUN_RULE,
     SINGLE_RULE,
@@ -121,6 +123,7 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
         f"<p>{html.escape(describe([n for _, n in ordered]))} {html.escape(BEST_RUN_RULE)}.</p>\n"
         f"{_runs_list(groups, numbers)}\n"
         f"{''.join(_tables(groups, ordered, estimates, runs[0].tasks))}\n"
+        f"{probe_html([(g.label, r.name, probe_target(r.path)) for g in groups for r in g.runs])}\n"
         f"{''.join(sections)}"
     )
     index = out / "index.html"

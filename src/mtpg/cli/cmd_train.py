@@ -165,7 +165,7 @@ def _train(args: argparse.Namespace) -> int:
 
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
-            config = merge_overrides(read_run_config(args.resume), overrides(args))
+            config = merge_overrides(read_run_config(args.resume, resuming=True), overrides(args))
             session = Session(args.resume, config, resume=True)
         else:
             config = build_config(args.preset, args.config, overrides(args))

@@ -101,6 +101,7 @@ def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
 
 
 def _value_labels(ax, xs, values, fmt="{:.2f}") -> None:
+    """Each value written clear of its marker: above it, or below it when negative."""
     for x, v in zip(xs, values, strict=True):
         text = "n/a" if not np.isfinite(v) else fmt.format(v)
         y = 0 if not np.isfinite(v) else v
@@ -108,9 +109,12 @@ def _value_labels(ax, xs, values, fmt="{:.2f}") -> None:
             text,
             (x, y),
             textcoords="offset points",
-            xytext=(0, 3 if y >= 0 else -9),
+            xytext=(0, 7 if y >= 0 else -7),
             ha="center",
+            va="bottom" if y >= 0 else "top",
             fontsize=7,
+            bbox={"boxstyle": "square,pad=0.1", "facecolor": "white", "edgecolor": "none"},
+            zorder=5,
         )
 
 
@@ -144,6 +148,7 @@ def normalised_vs_single(group: RunGroup, numbers: Numbers, path: Path) -> Path:
     if undefined:
         ax.plot([], [], "x", color="tab:red", label="undefined: single-task champion = random")
     _task_axis(ax, tasks)
+    ax.margins(y=0.12)  # room for the value labels above the highest marker
     ax.set_ylabel("normalised test score\n(0 = random, 1 = own single-task champion)")
     ax.set_title(f"All-task champions against single-task champions: {group.label}")
     ax.legend(fontsize=7)

@@ -6,6 +6,17 @@ import argparse
 import sys
 
 from mtpg.ablations import ABLATION_TABLE
+from mtpg.presets import PRESETS
+
+
+def preset_help() -> str:
+    """The help of ``--preset``: every preset by name, as :data:`mtpg.presets.PRESETS` has them."""
+    names = list(PRESETS)
+    listed = ", ".join(names[:-1]) + " or " + names[-1]
+    return (
+        f"configuration preset: {listed} (robust = paper with the training episodes redrawn "
+        "every 10 generations; default: demo)"
+    )
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -16,22 +27,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Evolve multi-task program graphs. Settings come from a preset, then "
         "--config FILE, then --set and the named options.",
     )
-    p.add_argument(
-        "--preset", default="demo", help="configuration preset: paper or demo (default: demo)"
-    )
+    p.add_argument("--preset", default="demo", help=preset_help())
     p.add_argument("--config", metavar="FILE", help="TOML file of settings")
     p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
     p.add_argument(
         "--generations",
         type=int,
-        help="generations to run (default: the preset's: 1000 paper, 250 demo)",
+        help="generations to run (default: the preset's: 1000 paper and robust, 250 demo)",
     )
     p.add_argument("--seed", type=int, help="run seed (default 0)")
     p.add_argument(
         "--workers",
         type=int,
-        help="threads evaluating episodes (default: the preset's: 1 paper, 2 demo; give "
-        "--workers 2 or more for paper runs; results do not depend on it)",
+        help="threads evaluating episodes (default: the preset's: 1 paper and robust, 2 demo; "
+        "give --workers 2 or more for paper runs; results do not depend on it)",
     )
     p.add_argument(
         "--backend",

@@ -75,6 +75,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     where.add_argument("--resume", metavar="RUN_DIR", help="continue the run in RUN_DIR")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument(
+        "--tensorboard",
+        metavar="DIR",
+        help="also log every generation's training scores, test scores, population sizes "
+        "and timings to TensorBoard event files in DIR (needs the tensorboard extra; off by "
+        "default; not stored with the run)",
+    )
     p.set_defaults(func=run)
 
 
@@ -171,6 +178,10 @@ def _train(args: argparse.Namespace) -> int:
     from mtpg.evolve.stopping import GracefulStop, StopNow, exit_code
 
     lost: BackendLost | None = None
+    if args.tensorboard is not None:
+        from mtpg.evolve.tensorboard import check_available
+
+        check_available()  # before anything is written
 
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
@@ -187,10 +198,15 @@ def _train(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         progress = None if args.quiet else Progress.for_session(session)
+        extra = []
+        if args.tensorboard is not None:
+            from mtpg.evolve.tensorboard import TensorBoardReporter
+
+            extra.append(TensorBoardReporter(args.tensorboard, tuple(cfg.evaluation.tasks)))
         try:
             # a signal stops at the next boundary; so does a lost cluster (run_all raises
             # BackendLost once the last generation is committed)
-            finished = session.run_all(progress, stop.requested)
+            finished = session.run_all(progress, stop.requested, extra)
         except BackendLost as exc:
             lost, finished = exc, False
         except StopNow as exc:

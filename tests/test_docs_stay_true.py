@@ -6,7 +6,14 @@ Every Markdown file of the project (README.md, CHANGELOG.md, docs/*.md, examples
   ...) must exist in the checkout;
 - an option written after ``mtpg COMMAND`` in a code span, a command block or a row of the
   README's command table must be an option of that command's parser;
-- counts that change with every commit (tests in the suite, lines of code) are not quoted.
+- counts that change with every commit (tests in the suite, lines of code) are not quoted;
+- a link's anchor names a heading of its page; examples import no ``mtpg.cli`` name;
+- figures quoted from the code (instruction set, subsets, bootstrap settings, seeds) are
+  the code's, and the README's results are those ``tools/results_readme.py`` wrote.
+
+Other checked quotes live beside what they check: the presets table
+(``tests/test_presets_documented.py``) and the progress line of docs/report.md
+(``tests/cli/test_progress_doc.py``).
 """
 
 import argparse
@@ -208,3 +215,33 @@ def test_the_architecture_page_names_the_runs_mtpg_experiment_plans():
     named = set(re.findall(r"`(TPG[\w-]*-seed\d+)`", text))
     planned = {run.path.name for run in plan(Path("x"), 1, 1)}
     assert named and named <= planned, named - planned
+
+
+def _flat(path: str) -> str:
+    return " ".join((ROOT / path).read_text(encoding="utf-8").split())
+
+
+def test_constants_the_documents_quote_are_the_code_s():
+    """Figures of the code itself, quoted in prose, equal the code's constants."""
+    from mtpg.analysis.runs import statistics
+    from mtpg.config import build_config
+    from mtpg.envs import protocol
+    from mtpg.model.instructions import CONSTANTS, OP_NAMES, RegisterLayout
+
+    layout = RegisterLayout()
+    readme = _flat("README.md")
+    assert (
+        f"({len(OP_NAMES)} operations, {layout.n_registers} private registers, "
+        f"{len(CONSTANTS)} constants)" in readme
+    )
+    assert f"**Memory bank**: {layout.n_memory} registers" in readme
+    paper = build_config("paper")
+    assert paper.evaluation.n_subsets == 63 and "each of the 63 non-empty sets" in readme
+    new_roots = paper.evaluation.n_subsets * paper.elites_per_subset
+    assert f"{new_roots:,} new roots per generation" in readme
+    report = _flat("docs/report.md")
+    assert f"over {statistics.N_RESAMPLES:,} resamples" in report
+    assert f"({statistics.N_RESAMPLES_PROFILE:,} resamples per threshold)" in report
+    assert f"generator is seeded (seed {statistics.BOOTSTRAP_SEED})" in report
+    assert f"`{protocol.TEST_SEED_BASE:,} + k`" in report
+    assert f"`{protocol.RANDOM_SEED_BASE:,} + i`" in report

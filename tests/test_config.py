@@ -154,7 +154,8 @@ ALL = "CartPole, Acrobot, CartCentering, Pendulum, MountainCar, MountainCarConti
             "evaluation.tasks must not repeat a task, got ('Pendulum', 'Pendulum')",
         ),
         ("seed=-1", "seed must be >= 0, got -1"),
-        ("generations=-1", "generations must be >= 0, got -1"),
+        ("generations=-1", "generations must be >= 1, got -1"),
+        ("generations=0", "generations must be >= 1, got 0"),
         ("workers=0", "workers must be >= 1, got 0"),
         ("checkpoint_interval=0", "checkpoint_interval must be >= 1, got 0"),
         ("team.root_size=1.5", "team.root_size must be int, got float 1.5"),
@@ -190,13 +191,13 @@ def test_boundary_values_are_accepted() -> None:
             "program.init_max_length=1",
             "program.max_length=1",
             "evaluation.test_interval=0",
-            "generations=0",
+            "generations=1",
             "seed=0",
         ],
     )
     assert cfg.team.p_crossover == 0.0 and isinstance(cfg.team.p_crossover, float)
     assert cfg.team.p_delete == 1.0
-    assert cfg.program.max_length == 1
+    assert cfg.program.max_length == 1 and cfg.generations == 1
     assert cfg.evaluation.test_interval == 0
 
 

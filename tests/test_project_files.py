@@ -24,7 +24,11 @@ def test_licence_and_citation():
     assert (ROOT / "LICENSE").read_text().startswith("MIT License")
     citation = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     assert citation["license"] == "MIT"
-    article = citation["preferred-citation"]
+    [article] = citation["references"]
+    assert article["type"] == "article"
+    assert " ".join(article["title"].split()) == (
+        "Evolving Hierarchical Memory-Prediction Machines in Multi-Task Reinforcement Learning"
+    )
     assert [a["family-names"] for a in article["authors"]] == [
         "Kelly",
         "Voegerl",
@@ -36,3 +40,16 @@ def test_licence_and_citation():
         22,
         2021,
     )
+
+
+def test_citation_describes_the_software_completely():
+    """The keys CFF 1.2.0 requires, plus those that make a software citation whole."""
+    citation = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    required = {"cff-version", "message", "title", "authors"}
+    assert required <= set(citation) and citation["cff-version"] == "1.2.0"
+    assert citation["type"] == "software" and citation["abstract"].strip()
+    assert citation["authors"] == [{"name": "the mtpg developers"}]
+    assert "references" in citation["message"]
+    # nothing unverified: no identifier or address is given without being known
+    assert not {"doi", "identifiers", "repository-code", "url"} & set(citation)
+    assert not {"doi", "url"} & set(citation["references"][0])

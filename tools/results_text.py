@@ -142,7 +142,7 @@ def compare_table(best, best_single: dict[str, float], tasks) -> list[str]:
         "task",
         "test return",
         "best single-task return",
-        "vs single",
+        "vs best single",
         f"paper (about {paper})",
         f"first reached {paper - LEVEL:.2f}",
         "vs reference",
@@ -203,7 +203,15 @@ def ablation_rows(groups, numbers, best_single, tasks) -> tuple[list[str], list[
     from mtpg.analysis.runs.loading import normalise_scores
     from mtpg.analysis.runs.reported_numbers import best_of
 
-    head = ["experiment", "run", "generation", "min vs single", "max vs single", "paper", "ours"]
+    head = [
+        "experiment",
+        "run",
+        "generation",
+        "min vs best single",
+        "max vs best single",
+        "paper",
+        "ours",
+    ]
     rows = []
     for g in groups:
         n = best_of([numbers[r.path] for r in g.runs])

@@ -285,7 +285,8 @@ class RunConfig:
     """Task and episode settings."""
 
     def __post_init__(self) -> None:
-        _positive(self, "run", ("seed", "generations"), minimum=0)
+        _positive(self, "run", ("seed",), minimum=0)
+        _positive(self, "run", ("generations",))  # 0 would leave a run without a champion
         _positive(self, "run", ("workers", "checkpoint_interval"))
         _positive(self, "run", ("dask_workers",), minimum=0)
         _check(self.backend in ("local", "dask"), "backend", "must be local or dask", self.backend)

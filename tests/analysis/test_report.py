@@ -61,6 +61,8 @@ EXPECTED = [
     "normalised_vs_reference.png",
     "normalised_vs_single.png",
     "performance_profile.png",
+    "probability_of_improvement.png",
+    "training_curves.png",
 ]
 
 
@@ -182,6 +184,7 @@ FIGURES = [
         g, n, {x.label: plots_stats.group_estimates(x, n) for x in g}, p
     ),
     lambda g, n, p: plots_stats.profile(g, n, p),
+    lambda g, n, p: plots_stats.improvement(g, n, plots_stats.improvements(g, n), p),
 ]
 
 

@@ -50,7 +50,7 @@ def test_version_is_the_installed_package_version():
     [
         ("report", "--out", "inside the first RUN_DIR"),
         ("analyze", "--out", "inside a run directory"),
-        ("train", "--workers", "1 paper, 2 demo"),
+        ("train", "--workers", "1 paper and robust, 2 demo"),
         ("train", "--no-crossover", "team.p_crossover=0"),
         ("train", "--set", "top-level fields take no section"),
     ],

@@ -63,4 +63,4 @@ def test_mp4_without_ffmpeg_says_what_to_install(graph, tmp_path, capsys, monkey
     mp4 = str(tmp_path / "a.mp4")
     assert main(["replay", str(graph), "--task", "CartPole", "--video", mp4]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "mtpg[video]" in err
+    assert len(err.splitlines()) == 1 and 'pip install -e ".[video]"' in err

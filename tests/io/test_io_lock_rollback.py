@@ -86,8 +86,14 @@ def test_read_run_config_names_the_file_and_the_problem(tmp_path) -> None:
 
 
 def test_read_run_config_of_a_directory_without_a_run_says_so(tmp_path) -> None:
-    with pytest.raises(RunDirError, match="holds no mtpg run to resume"):
+    # reading a run (report, evaluate) is not resuming it: the message says what is missing
+    with pytest.raises(RunDirError) as err:
         read_run_config(tmp_path)
+    assert str(err.value) == f"{tmp_path}: not an mtpg run directory (no config.toml)"
+    with pytest.raises(RunDirError, match="no such run directory"):
+        read_run_config(tmp_path / "missing")
+    with pytest.raises(RunDirError, match="holds no mtpg run to resume"):
+        read_run_config(tmp_path, resuming=True)
 
 
 def test_roll_back_removes_later_test_folders_and_temporary_files(tmp_path) -> None:

@@ -45,6 +45,8 @@ def resolve_graph(target: Path):
     """
     from mtpg.io.serialize import load_graph
 
+    if not target.exists():
+        raise FileNotFoundError(f"{target}: no such graph file or run directory")
     if target.is_dir():
         from mtpg.analysis.runs.champions import run_champion
         from mtpg.io.runconfig import read_run_config
@@ -105,19 +107,21 @@ def run(args: argparse.Namespace) -> int:
         if Path(args.target).is_dir() and "generation" in meta
         else "graph file"
     )
+    n_teams = len(pop.reachable(root))
     print(
-        f"{args.target}: {where}, root team {root}, {len(pop.reachable(root))} teams; "
+        f"{args.target}: {where}, root team {root}, {n_teams} team{'s' * (n_teams != 1)}; "
         f"{describe_held_out(args.episodes, args.seed)}; {memory}"
     )
     print(
         "normalised: 0 = random play, 1 = reference best"
         + ("; vs single: 1 = the run's own single-task champion, same generation" if single else "")
     )
-    header = f"{'task':<22} {'mean':>10} {'std':>9} {'normalised':>10} {'teams/dec':>9}"
+    width = max(22, *(len(t) for t in scores))  # variant names can be long
+    header = f"{'task':<{width}} {'mean':>10} {'std':>9} {'normalised':>10} {'teams/dec':>9}"
     print(header + (f" {'vs single':>9}" if single else ""))
     for t, s in scores.items():
         line = (
-            f"{t:<22} {s.mean:>10.3f} {s.std:>9.3f} {s.normalised:>10.3f} "
+            f"{t:<{width}} {s.mean:>10.3f} {s.std:>9.3f} {s.normalised:>10.3f} "
             f"{s.teams_per_decision:>9.2f}"
         )
         if t in single:

@@ -7,6 +7,8 @@ import argparse
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Adds the ``experiment`` command."""
+    from mtpg.cli.cmd_train import preset_help
+
     p = subparsers.add_parser(
         "experiment",
         help="several seeds plus the three ablations, then a report",
@@ -15,7 +17,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "then write the report. Rerunning the command resumes unfinished runs.",
     )
     p.add_argument("--out", required=True, metavar="DIR", help="experiment folder")
-    p.add_argument("--preset", default="demo", help="configuration preset (default demo)")
+    p.add_argument("--preset", default="demo", help=preset_help())
     p.add_argument("--config", metavar="FILE", help="TOML file of settings")
     p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
     p.add_argument("--generations", type=int, help="generations per run (default: the preset's)")

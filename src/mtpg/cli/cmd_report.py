@@ -12,8 +12,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="figures and an HTML page from run directories",
         description="Draw the figures of paper section 5 (learning curves, normalised scores, "
         "ablations, teams per decision) and the statistics across seeds (interquartile mean "
-        "with 95% stratified bootstrap confidence intervals, performance profile) from the "
-        "test results of one or more runs. Runs are grouped by configuration; runs that "
+        "with 95% stratified bootstrap confidence intervals, performance profile, probability "
+        "of improvement between experiments) from the test results of one or more runs, and "
+        "training curves (training scores, population and bank sizes) from their "
+        "metrics.csv. Runs are grouped by configuration; runs that "
         "differ in more than the seed and the ablation switches are reported with a warning.",
     )
     p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="run directories")

@@ -6,6 +6,17 @@ import argparse
 import sys
 
 from mtpg.ablations import ABLATION_TABLE
+from mtpg.presets import PRESETS
+
+
+def preset_help() -> str:
+    """The help of ``--preset``: every preset by name, as :data:`mtpg.presets.PRESETS` has them."""
+    names = list(PRESETS)
+    listed = ", ".join(names[:-1]) + " or " + names[-1]
+    return (
+        f"configuration preset: {listed} (robust = paper with the training episodes redrawn "
+        "every 10 generations; default: demo)"
+    )
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -16,22 +27,20 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Evolve multi-task program graphs. Settings come from a preset, then "
         "--config FILE, then --set and the named options.",
     )
-    p.add_argument(
-        "--preset", default="demo", help="configuration preset: paper or demo (default: demo)"
-    )
+    p.add_argument("--preset", default="demo", help=preset_help())
     p.add_argument("--config", metavar="FILE", help="TOML file of settings")
     p.add_argument("--tasks", help="comma-separated task names (default: the preset's)")
     p.add_argument(
         "--generations",
         type=int,
-        help="generations to run (default: the preset's: 1000 paper, 250 demo)",
+        help="generations to run (default: the preset's: 1000 paper and robust, 250 demo)",
     )
     p.add_argument("--seed", type=int, help="run seed (default 0)")
     p.add_argument(
         "--workers",
         type=int,
-        help="threads evaluating episodes (default: the preset's: 1 paper, 2 demo; give "
-        "--workers 2 or more for paper runs; results do not depend on it)",
+        help="threads evaluating episodes (default: the preset's: 1 paper and robust, 2 demo; "
+        "give --workers 2 or more for paper runs; results do not depend on it)",
     )
     p.add_argument(
         "--backend",
@@ -66,6 +75,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     where.add_argument("--resume", metavar="RUN_DIR", help="continue the run in RUN_DIR")
     p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument(
+        "--tensorboard",
+        metavar="DIR",
+        help="also log every generation's training scores, test scores, population sizes "
+        "and timings to TensorBoard event files in DIR (needs the tensorboard extra; off by "
+        "default; not stored with the run)",
+    )
     p.set_defaults(func=run)
 
 
@@ -162,10 +178,14 @@ def _train(args: argparse.Namespace) -> int:
     from mtpg.evolve.stopping import GracefulStop, StopNow, exit_code
 
     lost: BackendLost | None = None
+    if args.tensorboard is not None:
+        from mtpg.evolve.tensorboard import check_available
+
+        check_available()  # before anything is written
 
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
-            config = merge_overrides(read_run_config(args.resume), overrides(args))
+            config = merge_overrides(read_run_config(args.resume, resuming=True), overrides(args))
             session = Session(args.resume, config, resume=True)
         else:
             config = build_config(args.preset, args.config, overrides(args))
@@ -178,10 +198,15 @@ def _train(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         progress = None if args.quiet else Progress.for_session(session)
+        extra = []
+        if args.tensorboard is not None:
+            from mtpg.evolve.tensorboard import TensorBoardReporter
+
+            extra.append(TensorBoardReporter(args.tensorboard, tuple(cfg.evaluation.tasks)))
         try:
             # a signal stops at the next boundary; so does a lost cluster (run_all raises
             # BackendLost once the last generation is committed)
-            finished = session.run_all(progress, stop.requested)
+            finished = session.run_all(progress, stop.requested, extra)
         except BackendLost as exc:
             lost, finished = exc, False
         except StopNow as exc:

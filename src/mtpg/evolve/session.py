@@ -18,7 +18,7 @@ Guarantees (see ``docs/runs.md``):
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -37,6 +37,7 @@ from mtpg.evolve.reporters import (
     CallbackReporter,
     CheckpointReporter,
     MetricsReporter,
+    Reporter,
     TestsReporter,
     champion_graphs,
     train,
@@ -189,7 +190,10 @@ class Session:
                 entry.unlink()
 
     def run_all(
-        self, on_generation: Callback | None = None, should_stop: Callable[[], bool] | None = None
+        self,
+        on_generation: Callback | None = None,
+        should_stop: Callable[[], bool] | None = None,
+        reporters: Sequence[Reporter] = (),
     ) -> bool:
         """Runs the remaining generations, then releases the directory.
 
@@ -202,6 +206,8 @@ class Session:
             on_generation: Called with each metrics row and the trainer (e.g. progress).
             should_stop: Asked before each generation; True ends the run there, after
                 committing the last completed generation.
+            reporters: More observers of each committed generation, after the run's own
+                (e.g. :class:`mtpg.evolve.tensorboard.TensorBoardReporter`).
 
         Returns:
             True when every configured generation has run, False when stopped early.
@@ -209,9 +215,9 @@ class Session:
         Raises:
             BackendLost: The backend was lost; the last generation is committed.
         """
-        reporters = [self.metrics, self.tests, self.checkpoints]
+        observers: list[Reporter] = [self.metrics, self.tests, self.checkpoints, *reporters]
         if on_generation is not None:
-            reporters.append(CallbackReporter(on_generation))
+            observers.append(CallbackReporter(on_generation))
         lost: list[BackendLost] = []
 
         def stop_here() -> bool:
@@ -225,7 +231,7 @@ class Session:
             return False
 
         try:
-            finished = train(self.trainer, reporters, stop_here)
+            finished = train(self.trainer, observers, stop_here)
         finally:
             self.close()
         if lost:

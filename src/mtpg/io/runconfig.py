@@ -6,16 +6,29 @@ import tomllib
 from pathlib import Path
 
 from mtpg.config import ConfigError, RunConfig, from_dict
-from mtpg.io.rundir import RunDir, check_resumable
+from mtpg.io.rundir import RunDir, check_resumable, check_run
 
 
-def read_run_config(run_dir: str | Path) -> RunConfig:
-    """Reads the resolved configuration stored in a run directory."""
+def read_run_config(run_dir: str | Path, resuming: bool = False) -> RunConfig:
+    """Reads the resolved configuration stored in a run directory.
+
+    Args:
+        run_dir: The run directory.
+        resuming: The caller resumes the run (``mtpg train --resume``): a directory that
+            holds no run is then refused in the words of resuming.
+
+    Raises:
+        RunDirError: When ``run_dir`` holds no run (the message says why).
+        ConfigError: When its ``config.toml`` cannot be read or is not valid.
+    """
     path = RunDir(Path(run_dir)).config
     try:
         text = path.read_text(encoding="utf-8")
     except (FileNotFoundError, NotADirectoryError):
-        check_resumable(run_dir)  # says why when the directory holds no run
+        if resuming:
+            check_resumable(run_dir)  # says why when the directory holds no run to resume
+        else:
+            check_run(run_dir)
         raise ConfigError(f"{path}: no such file") from None
     except (OSError, UnicodeDecodeError) as exc:
         why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"

@@ -118,6 +118,11 @@ def check_new_run_dir(path: str | os.PathLike[str]) -> bool:
     if not run.path.exists():
         return False
     entries = sorted(e.name for e in run.path.iterdir())
+    if run.config.is_file() and _has_checkpoint(run):  # a run, perhaps with its reports
+        raise RunDirError(
+            f"{run.path}: already holds an mtpg run; resume it (mtpg train --resume "
+            f"{run.path}) or choose another directory"
+        )
     foreign = [n for n in entries if n not in RUN_NAMES and not is_temp_file(n)]
     if foreign:
         shown = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
@@ -189,6 +194,30 @@ def init_run_dir(
     if not resume:
         point("created", 0)
     return run
+
+
+def check_run(path: str | os.PathLike[str]) -> None:
+    """Raises :class:`RunDirError` unless ``path`` holds an mtpg run, saying why.
+
+    For commands that read a run (``report``, ``evaluate``, ...); ``mtpg train --resume``
+    uses :func:`check_resumable`, whose messages speak of resuming.
+    """
+    run = RunDir(Path(path))
+    if not run.path.exists():
+        raise RunDirError(f"{run.path}: no such run directory")
+    if not run.path.is_dir():
+        raise RunDirError(f"{run.path}: exists and is not a directory")
+    if is_run_dir(run.path):
+        return
+    names = [e.name for e in run.path.iterdir()]
+    if names and not run.config.is_file():
+        if all(n in RUN_NAMES or is_temp_file(n) for n in names):
+            raise RunDirError(
+                f"{run.path}: holds no mtpg run (its creation was interrupted before "
+                f"{CONFIG_FILE} was written); start it again with mtpg train --out {run.path}"
+            )
+    missing = CONFIG_FILE if not run.config.is_file() else f"{CHECKPOINT_DIR}/"
+    raise RunDirError(f"{run.path}: not an mtpg run directory (no {missing})")
 
 
 def check_resumable(path: str | os.PathLike[str]) -> None:

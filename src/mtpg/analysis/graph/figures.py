@@ -19,6 +19,10 @@ from mtpg.analysis.palette import (
 )
 from mtpg.analysis.plotting import pyplot, save
 
+#: Smallest |Pearson r| at which the velocity panel calls a register a velocity prediction;
+#: below it the panel says that no register tracks the velocity (sec. 6.3 reads r as such).
+TRACKS_R = 0.3
+
 
 def _task_legend(fig_or_ax, tasks, **kw) -> None:
     from matplotlib.patches import Patch
@@ -97,7 +101,13 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
         kernel = np.ones(window) / window
         for ax, key in ((axes[0], "teams"), (axes[1], "instructions")):
             mean = np.convolve(series[key], kernel, mode="valid")
-            ax.plot(steps[window - 1 :], mean, color="black", lw=1.0, label=f"mean of {window}")
+            ax.plot(
+                steps[window - 1 :],
+                mean,
+                color="black",
+                lw=1.0,
+                label=f"running mean over {window} steps",
+            )
             ax.legend(fontsize=7, loc="lower left")
     has = ~np.isnan(series["oldest"])
     if has.any():
@@ -125,7 +135,23 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
             label=f"register {prediction['label']}{neg}, Pearson r = {r:.2f}",
         )
     ax.set_ylim(-1.15, 1.45)
-    ax.set_ylabel("velocity prediction\n(scaled to [-1, 1])")
+    r = prediction["r"]
+    tracks = prediction["label"] and abs(r) >= TRACKS_R
+    ax.set_ylabel(
+        ("velocity prediction" if tracks else "hidden velocity and\nclosest register")
+        + "\n(scaled to [-1, 1])"
+    )
+    if not tracks:  # a weak correlation is no prediction: say so on the panel
+        ax.text(
+            0.99,
+            0.97,
+            f"no register tracks the velocity (|r| < {TRACKS_R})",
+            ha="right",
+            va="top",
+            fontsize=7,
+            color="0.3",
+            transform=ax.transAxes,
+        )
     ax.legend(fontsize=7, loc="upper left", ncol=2)
     ax.set_xlabel("time step")
     fig.suptitle(title, fontsize=11)

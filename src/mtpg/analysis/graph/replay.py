@@ -51,6 +51,7 @@ mem_from_reset         (A,)        True when the value had not been written in t
 
 from __future__ import annotations
 
+from collections.abc import Iterator, KeysView
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -86,6 +87,20 @@ class Replay:
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self.data[key]
+
+    def __iter__(self) -> Iterator[str]:
+        """The schema keys, as iterating over the ``.npz`` file gives them."""
+        return iter(self.data)
+
+    def __len__(self) -> int:
+        return len(self.data)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.data
+
+    def keys(self) -> KeysView[str]:
+        """The schema keys (``dict(replay)`` and ``np.savez(f, **replay)`` work)."""
+        return self.data.keys()
 
     @property
     def task(self) -> str:

@@ -3,7 +3,7 @@
 One frame per decision: the task as it was when the decision was made (the state before
 the step) and the path of teams visited (green; the team that chose the action has a
 thick outline). GIF files need only matplotlib and Pillow; MP4 files need an ffmpeg
-program, which the ``video`` extra installs (``pip install "mtpg[video]"``).
+program, which the ``video`` extra installs (``pip install -e ".[video]"`` in the checkout).
 """
 
 from __future__ import annotations
@@ -38,8 +38,8 @@ def ffmpeg_writer(fps: int):
         pass
     if not FFMpegWriter.isAvailable():
         raise ValueError(
-            'MP4 needs ffmpeg: install the extra with pip install "mtpg[video]" '
-            "(or write a .gif instead)"
+            'MP4 needs ffmpeg: install the extra with pip install -e ".[video]" in the '
+            "mtpg checkout (or write a .gif instead)"
         )
     return FFMpegWriter(fps=fps)
 

@@ -29,6 +29,7 @@ from mtpg.analysis.runs.reported_numbers import (
     describe,
     run_numbers,
 )
+from mtpg.analysis.runs.training_curves import training_curves
 
 
 class MixedRunsWarning(UserWarning):
@@ -110,11 +111,12 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
         warnings.warn(text, MixedRunsWarning, stacklevel=2)
     numbers = {r.path: run_numbers(r) for r in runs}
     estimates = {g.label: statistics_figures.group_estimates(g, numbers) for g in groups}
+    pairs = statistics_figures.improvements(groups, numbers)
     out = Path(out) if out is not None else runs[0].path / "report"
     out.mkdir(parents=True, exist_ok=True)
     sections = [
         pages.figure(draw(out / name), title)
-        for name, title, draw in _figures(groups, numbers, estimates)
+        for name, title, draw in _figures(groups, numbers, estimates, pairs)
     ]
     ordered = [(g.label, numbers[r.path]) for g in groups for r in g.runs]
     warn_html = "".join(f'<p class="warn">Warning: {html.escape(w)}</p>' for w in mixed)
@@ -124,6 +126,7 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
         f"{_runs_list(groups, numbers)}\n"
         f"{''.join(_tables(groups, ordered, estimates, runs[0].tasks))}\n"
         f"{probe_html([(g.label, r.name, probe_target(r.path)) for g in groups for r in g.runs])}\n"
+        f"{_improvement_table(pairs)}\n"
         f"{''.join(sections)}"
     )
     index = out / "index.html"
@@ -142,7 +145,23 @@ def _load_runs(run_dirs: list[str | Path]) -> list[RunData]:
     return runs
 
 
-def _figures(groups: list[RunGroup], numbers: Numbers, estimates) -> list[Figure]:
+def _improvement_table(pairs) -> str:
+    """P(X > Y) with its interval for every pair, or nothing with a single group."""
+    if not pairs:
+        return ""
+    body = "".join(
+        f"<tr><td>P({html.escape(x)} &gt; {html.escape(y)})</td>"
+        f"<td>{html.escape(e.text(3))}</td></tr>"
+        for (x, y), e in pairs.items()
+    )
+    note = html.escape(statistics_figures.POI_NOTE)
+    return (
+        f"<h2>Probability of improvement [95% CI]</h2><p>{note}</p>"
+        f"<table><tr><th>pair</th><th>estimate [95% CI]</th></tr>{body}</table>"
+    )
+
+
+def _figures(groups: list[RunGroup], numbers: Numbers, estimates, pairs) -> list[Figure]:
     """The report's figures in page order: Figs. 4-6, 7 (several experiments), 8, statistics."""
     main = groups[0]
     figures: list[Figure] = [
@@ -185,6 +204,22 @@ def _figures(groups: list[RunGroup], numbers: Numbers, estimates) -> list[Figure
             "performance_profile.png",
             "Across seeds: performance profile",
             lambda p: statistics_figures.profile(groups, numbers, p),
+        ),
+        *(
+            [
+                (
+                    "probability_of_improvement.png",
+                    "Between experiments: probability of improvement",
+                    lambda p: statistics_figures.improvement(groups, numbers, pairs, p),
+                )
+            ]
+            if pairs
+            else []
+        ),
+        (
+            "training_curves.png",
+            "Training scores and population sizes over generations (metrics.csv)",
+            lambda p: training_curves(groups, p),
         ),
     ]
 

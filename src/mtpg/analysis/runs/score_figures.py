@@ -100,7 +100,13 @@ def learning_curves(group: RunGroup, numbers: Numbers, path: Path) -> Path:
     return finish(fig, path, caption, legend_rows=1)
 
 
-def _value_labels(ax, xs, values, fmt="{:.2f}") -> None:
+def _value_labels(ax, xs, values, fmt="{:.2f}", markers: bool = False) -> None:
+    """Each value written above its bar or marker, or below it when negative.
+
+    Beside markers (``markers``) the labels stand further off and on a white ground, so
+    that neither hides the other; on bars they sit close and clear, as a ground would hide
+    the neighbouring bars.
+    """
     for x, v in zip(xs, values, strict=True):
         text = "n/a" if not np.isfinite(v) else fmt.format(v)
         y = 0 if not np.isfinite(v) else v
@@ -108,9 +114,16 @@ def _value_labels(ax, xs, values, fmt="{:.2f}") -> None:
             text,
             (x, y),
             textcoords="offset points",
-            xytext=(0, 3 if y >= 0 else -9),
+            xytext=(0, (7 if markers else 2) * (1 if y >= 0 else -1)),
             ha="center",
+            va="bottom" if y >= 0 else "top",
             fontsize=7,
+            bbox=(
+                {"boxstyle": "square,pad=0.1", "facecolor": "white", "edgecolor": "none"}
+                if markers
+                else None
+            ),
+            zorder=5,
         )
 
 
@@ -140,10 +153,11 @@ def normalised_vs_single(group: RunGroup, numbers: Numbers, path: Path) -> Path:
             undefined = True
             ax.plot(np.flatnonzero(bad), np.zeros(bad.sum()), "x", color="tab:red", ms=9)
         if is_best:
-            _value_labels(ax, range(len(tasks)), ys)
+            _value_labels(ax, range(len(tasks)), ys, markers=True)
     if undefined:
         ax.plot([], [], "x", color="tab:red", label="undefined: single-task champion = random")
     _task_axis(ax, tasks)
+    ax.margins(y=0.12)  # room for the value labels above the highest marker
     ax.set_ylabel("normalised test score\n(0 = random, 1 = own single-task champion)")
     ax.set_title(f"All-task champions against single-task champions: {group.label}")
     ax.legend(fontsize=7)
@@ -159,6 +173,7 @@ def _bars(ax, tasks, groups: dict[str, dict[str, float]]) -> None:
         ax.bar(xs, np.where(np.isfinite(ys), ys, 0.0), width, label=name)
         _value_labels(ax, xs, ys)
     _task_axis(ax, tasks)
+    ax.margins(y=0.1)  # room for the labels of the highest and lowest bars
 
 
 def normalised_vs_reference(group: RunGroup, numbers: Numbers, path: Path) -> Path:
@@ -210,13 +225,16 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
     fig, ax = plt.subplots(figsize=(8.5, 5))
     _bars(ax, tasks, bars)
     label = groups[0].label
-    ax.set_ylabel(f"normalised test score\n(0 = random, 1 = best single-task, {label})")
+    ax.set_ylabel(
+        f"vs best single: normalised test score\n(0 = random, 1 = best single-task, {label})"
+    )
     title_and_legend_above(ax, "Experiments: the best run's all-task champion of each")
     caption = (
-        f"{describe(shown)} Normalised: 0 = random play, 1 = the best single-task champion "
-        f"of the {len(ref_runs)} {label} run(s) by test score (each run's best root on the "
-        f"task alone by training score, at its final test point); n/a where it is no better "
-        f"than random. Best run of each experiment: "
-        f"{BEST_RUN_RULE.removeprefix('Best run = ')}."
+        f"{describe(shown)} Normalised (vs best single): 0 = random play, 1 = the best "
+        f"single-task champion of the {len(ref_runs)} {label} run(s) by test score (each "
+        "run's best root on the task alone by training score, at its final test point; "
+        "choosing the best of them by test score biases the ratios downward, "
+        "docs/report.md); n/a where it is no better than random. Best run of each "
+        f"experiment: {BEST_RUN_RULE.removeprefix('Best run = ')}."
     )
     return finish(fig, path, caption)

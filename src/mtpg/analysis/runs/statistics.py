@@ -13,6 +13,11 @@ Statistical Precipice* (NeurIPS 2021) and their ``rliable`` library, computed wi
   ``method="percentile"``, as rliable's default).
 - **Performance profile**: the fraction of (run, task) scores above each threshold tau,
   with a stratified bootstrap band at each tau.
+- **Probability of improvement** of group X over group Y: the chance that a run of X
+  scores higher than a run of Y on a task, ties counting one half, averaged over tasks:
+  ``mean_t mean_{i,j} S(x_it, y_jt)`` with ``S = 1, 0.5, 0`` for ``>, =, <`` (the
+  Mann-Whitney U statistic over ``n m`` per task; ``rliable.metrics.probability_of_improvement``).
+  Its interval resamples the runs of both groups within every task independently.
 
 SciPy rather than ``rliable`` itself: rliable needs ``arch``, ``pandas``, ``seaborn`` and
 ``absl-py`` for the three functions used here, while SciPy's bootstrap is well kept and
@@ -163,3 +168,48 @@ def performance_profile(
 
         low[k], high[k] = _bootstrap(scores, above, n_resamples, seed)
     return frac, low, high
+
+
+def _improvement(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Probability of improvement of batches of (runs x tasks) matrices ``x`` over ``y``."""
+    wins = x[..., :, None, :] > y[..., None, :, :]
+    ties = x[..., :, None, :] == y[..., None, :, :]
+    per_task = (wins + 0.5 * ties).mean(axis=(-3, -2))
+    return per_task.mean(axis=-1)
+
+
+def probability_of_improvement(
+    x: np.ndarray, y: np.ndarray, n_resamples: int = N_RESAMPLES, seed: int = BOOTSTRAP_SEED
+) -> Estimate:
+    """P(X > Y): how often a run of group X beats a run of group Y on a task, over tasks.
+
+    Args:
+        x: (runs x tasks) scores of group X.
+        y: (runs x tasks) scores of group Y, on the same tasks.
+        n_resamples: Bootstrap resamples.
+        seed: Seed of the bootstrap generator.
+
+    Returns:
+        The estimate (0.5: neither better), with a 95% stratified bootstrap percentile
+        interval: every resample redraws, with replacement, the runs of each group within
+        every task independently (rliable's ``StratifiedIndependentBootstrap``). A group of
+        one run is redrawn as itself; with one run in both groups there is no interval.
+        ``runs`` is the larger group's size.
+    """
+    x, y = _check(x), _check(y)
+    if x.shape[1] != y.shape[1]:
+        raise ValueError(f"the groups have {x.shape[1]} and {y.shape[1]} tasks")
+    value = float(_improvement(x, y))
+    runs = max(x.shape[0], y.shape[0])
+    if runs < 2:
+        return Estimate(value, float("nan"), float("nan"), runs)
+    rng = np.random.default_rng(seed)
+    stats = np.empty(n_resamples)
+    tasks = np.arange(x.shape[1])
+    for start in range(0, n_resamples, 2_000):  # in blocks: bounded memory
+        b = min(2_000, n_resamples - start)
+        ix = rng.integers(0, x.shape[0], size=(b, x.shape[0], x.shape[1]))
+        iy = rng.integers(0, y.shape[0], size=(b, y.shape[0], y.shape[1]))
+        stats[start : start + b] = _improvement(x[ix, tasks], y[iy, tasks])
+    low, high = np.percentile(stats, [50 * (1 - CONFIDENCE), 50 * (1 + CONFIDENCE)])
+    return Estimate(value, float(low), float(high), runs)

@@ -122,3 +122,64 @@ def profile(groups: list[RunGroup], numbers: dict[Path, RunNumbers], path: Path)
         f"({stats.N_RESAMPLES_PROFILE:,} resamples per threshold; none for a single run)."
     )
     return finish(fig, path, caption)
+
+
+def improvements(
+    groups: list[RunGroup], numbers: dict[Path, RunNumbers]
+) -> dict[tuple[str, str], stats.Estimate]:
+    """P(first group > X) for every other group X (P(X > first) is one minus it)."""
+    first = groups[0]
+    base = score_matrix(first, numbers)
+    return {
+        (first.label, g.label): stats.probability_of_improvement(base, score_matrix(g, numbers))
+        for g in groups[1:]
+    }
+
+
+POI_NOTE = (
+    "Probability of improvement P(X > Y): the chance that a run of X has a higher "
+    "normalised test score than a run of Y on a task (ties count one half), averaged over "
+    "tasks; 0.5 = neither is better. Bars: 95% stratified bootstrap intervals (the runs of "
+    f"both groups resampled within each task; {stats.N_RESAMPLES:,} resamples, percentile "
+    "method; a group of one run is resampled as itself); none when both have one run. "
+    "P(Y > X) = 1 - P(X > Y)."
+)
+
+
+def improvement(
+    groups: list[RunGroup],
+    numbers: dict[Path, RunNumbers],
+    estimates: dict[tuple[str, str], stats.Estimate],
+    path: Path,
+) -> Path:
+    """P(X > Y) with its interval for the pairs of :func:`improvements`, one row each."""
+    plt = pyplot()
+    pairs = list(estimates)
+    fig, ax = plt.subplots(figsize=(7.5, 1.2 + 0.45 * len(pairs) + 1.5))
+    ys = np.arange(len(pairs))[::-1]
+    for y, pair in zip(ys, pairs, strict=True):
+        e = estimates[pair]
+        if np.isfinite(e.low):
+            ax.plot([e.low, e.high], [y, y], color="tab:blue", lw=6, alpha=0.45)
+        ax.plot([e.value], [y], "|", color="black", ms=14, mew=2)
+        ax.annotate(
+            e.text(2),
+            (e.value, y),
+            textcoords="offset points",
+            xytext=(0, 9),
+            ha="center",
+            fontsize=7,
+        )
+    ax.set_yticks(ys)
+    ax.set_yticklabels([f"P({x} > {y})" for x, y in pairs], fontsize=8)
+    ax.axvline(0.5, color="0.5", lw=0.8, ls="--")
+    ax.set_xlim(0, 1)
+    ax.set_ylim(-0.7, len(pairs) - 0.3)
+    ax.set_xlabel("probability of improvement (0.5 = neither better)")
+    ax.set_ylabel("pair of experiments")
+    ax.set_title("Pairwise comparison of experiments")
+    ax.plot([], [], color="tab:blue", lw=6, alpha=0.45, label="95% CI")
+    ax.plot([], [], "|", color="black", ms=10, mew=2, label="estimate")
+    ax.legend(fontsize=7, loc="lower right")
+    shown = [numbers[r.path] for g in groups for r in g.runs]
+    return finish(fig, path, f"{describe(shown)} {POI_NOTE}")

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from graph_strategies import tangled_cases
 from mtpg.engine.batch import Episodes, run_jobs
 from mtpg.engine.compile import compile_population
-from mtpg.engine.lanes import registers_to_zero
+from mtpg.engine.lane_graph import P_ACT, P_GLOBAL, localise, registers_to_zero, unlocalise
 from mtpg.engine.ops import OP_COPY
 from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.envs.core import TASK_NAMES
@@ -73,7 +73,12 @@ def test_lanes_equal_scalar_on_layered_graphs_and_threads(no_memory, fold):
 
 def test_lanes_equal_scalar_with_other_register_sizes():
     rng = np.random.default_rng(8)
-    for layout in (RegisterLayout(n_registers=3, n_memory=2), RegisterLayout(n_registers=12)):
+    layouts = (
+        RegisterLayout(n_registers=3, n_memory=2),
+        RegisterLayout(n_registers=12),
+        RegisterLayout(n_registers=70, n_memory=3),  # above 64: every register zeroed
+    )
+    for layout in layouts:
         pop = tangled_population(rng, 5, 20, 25, 4, 0.5, layout)
         cp = compile_population(pop)
         episodes = Episodes.grid(ALL_TASKS, [0, 1])
@@ -115,4 +120,30 @@ def _prog(*rows):
 )
 def test_registers_to_zero(rows, want):
     instrs, offsets = _prog(*rows)
-    assert int(registers_to_zero(instrs, offsets, 8)[0]) == want
+    assert int(registers_to_zero(instrs, offsets[0], offsets[1], 8)) == want
+
+
+def test_a_block_graph_is_local_and_the_maps_are_left_clean():
+    """localise numbers the reachable teams, programs and banks; unlocalise undoes it."""
+    rng = np.random.default_rng(4)
+    pop = tangled_population(rng, 6, 20, 10, 4, 0.6)
+    g = compile_population(pop).graph
+    n_teams, n_progs = len(g.team_offsets) - 1, len(g.prog_offsets) - 1
+    n_banks = int(g.prog_bank.max()) + 1
+    maps = np.full((3, max(n_teams, n_progs, n_banks)), -1, dtype=np.int64)
+    lteam, lteam_off = np.zeros(n_teams, np.int64), np.zeros(n_teams + 1, np.int64)
+    lprog = np.zeros((len(g.team_members), 7), np.int64)
+    lcode = np.zeros((len(g.instrs), 6), np.uint64)
+    lbank, counts = np.zeros(n_banks, np.int64), np.zeros(4, np.int64)
+    roots = np.array([0], dtype=np.int64)
+    localise(g, roots, 4, 10_000, maps, lteam, lteam_off, lprog, lcode, lbank, counts)
+    n_lt, n_lp = int(counts[0]), int(counts[1])
+    assert lteam[0] == 0 and n_lt >= 1 and lteam_off[n_lt] == n_lp
+    for lt in range(n_lt):  # every local team holds its global team's programs, in order
+        t = lteam[lt]
+        members = g.team_members[g.team_offsets[t] : g.team_offsets[t + 1]]
+        assert list(lprog[lteam_off[lt] : lteam_off[lt + 1], P_GLOBAL]) == list(members)
+        for row in lprog[lteam_off[lt] : lteam_off[lt + 1]]:  # pointers stay in the block
+            assert row[P_ACT] < n_lt
+    unlocalise(maps, lteam, lprog, lbank, counts)
+    assert (maps == -1).all()

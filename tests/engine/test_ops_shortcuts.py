@@ -15,7 +15,7 @@ import math
 import numpy as np
 import pytest
 
-from mtpg.engine.lanes import lane_op
+from mtpg.engine.lane_ops import lane_op
 from mtpg.engine.ops import OP_COPY, POW_SAFE_HI, POW_SAFE_LO, apply_op
 from mtpg.engine.reference import reference_op
 from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, N_OPS
@@ -95,7 +95,21 @@ def test_lane_loops_equal_apply_op(op):
     want = [apply_op(op, W[k], W[n_lanes + k], W[2 * n_lanes + k]) for k in range(n_lanes)]
     grp = rng.permutation(n_lanes).astype(np.uint64)[: n_lanes - 3]  # some lanes left out
     before = W.copy()
-    lane_op(W, op, np.uint64(0), np.uint64(n_lanes), np.uint64(2 * n_lanes), grp, len(grp))
+    every = ~np.uint64(0)
+    lane_op(
+        W, op, np.uint64(0), np.uint64(n_lanes), every, np.uint64(2 * n_lanes), every, grp, len(grp)
+    )
+    in_grp = set(grp.tolist())
     for k in range(n_lanes):
-        expect = want[k] if k in set(grp.tolist()) else before[k]
+        expect = want[k] if k in in_grp else before[k]
+        assert _bits(W[k]) == _bits(expect), (op, k)
+    # a shared operand (a constant): every lane reads the one value at its address
+    W = before.copy()
+    c = 2 * n_lanes + 5
+    want = [apply_op(op, W[k], W[n_lanes + k], W[c]) for k in range(n_lanes)]
+    lane_op(
+        W, op, np.uint64(0), np.uint64(n_lanes), every, np.uint64(c), np.uint64(0), grp, len(grp)
+    )
+    for k in range(n_lanes):
+        expect = want[k] if k in in_grp else before[k]
         assert _bits(W[k]) == _bits(expect), (op, k)

@@ -26,13 +26,27 @@ with the step's mark.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
 from mtpg.engine.kernels import _fetch_add
-from mtpg.engine.ops import _clamp, op_cos, op_div, op_exp, op_log, op_pow, op_sin, op_tanh
+from mtpg.engine.lane_graph import (
+    C_A,
+    C_B,
+    C_DST,
+    C_MA,
+    C_MB,
+    C_OP,
+    P_ACT,
+    P_BANK,
+    P_COUNT,
+    P_HI,
+    P_LO,
+    P_ZERO,
+    localise,
+    unlocalise,
+)
+from mtpg.engine.lane_ops import lane_op
 from mtpg.envs.core import STATE_SIZE
 from mtpg.envs.kernels import add_obs_noise, env_reset, observe_kind, task_observe, task_step
 from mtpg.envs.tasks import P_KIND, P_OBS_SD
@@ -43,125 +57,6 @@ _CONSTANTS = CONSTANTS.copy()
 #: Lanes of one block when the caller does not choose: one root's training episodes
 #: (6 tasks x 5) fit in one block; results do not depend on it.
 DEFAULT_LANES = 32
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def lane_op(Wf, op, ud, ua, ub, grp, n):
-    """Runs one instruction over the lanes ``grp[:n]``: one loop per op code.
-
-    Each loop computes :func:`~mtpg.engine.ops.apply_op`'s value for its op code with the
-    same functions, so the op code is tested once per group, not once per lane.
-    """
-    if op == 0:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(Wf[ua + lane] + Wf[ub + lane])
-    elif op == 1:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(Wf[ua + lane] - Wf[ub + lane])
-    elif op == 2:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(Wf[ua + lane] * Wf[ub + lane])
-    elif op == 3:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(op_div(Wf[ua + lane], Wf[ub + lane]))
-    elif op == 4:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(op_pow(Wf[ua + lane], Wf[ub + lane]))
-    elif op == 5:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = op_cos(Wf[ub + lane])  # within [-1, 1]: the clamp changes nothing
-    elif op == 6:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(op_log(Wf[ub + lane]))
-    elif op == 7:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(op_exp(Wf[ub + lane]))
-    elif op == 8:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = _clamp(math.sqrt(abs(Wf[ub + lane])))
-    elif op == 9:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = op_sin(Wf[ub + lane])  # within [-1, 1]
-    elif op == 10:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = op_tanh(Wf[ub + lane])  # within [-1, 1]
-    elif op == 11:
-        for k in range(n):
-            lane = grp[k]
-            b = Wf[ub + lane]
-            Wf[ud + lane] = _clamp(b * b)
-    elif op == 12:
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = abs(Wf[ub + lane])  # operands are within [-BIG, BIG]
-    elif op == 13:
-        for k in range(n):
-            lane = grp[k]
-            b = Wf[ub + lane]
-            Wf[ud + lane] = _clamp(b * b * b)
-    elif op == 14:
-        for k in range(n):
-            lane = grp[k]
-            d = Wf[ud + lane]
-            Wf[ud + lane] = -d if Wf[ua + lane] < Wf[ub + lane] else d
-    elif op == 15:
-        for k in range(n):
-            lane = grp[k]
-            d = Wf[ud + lane]
-            Wf[ud + lane] = -d if Wf[ua + lane] > Wf[ub + lane] else d
-    else:  # OP_COPY
-        for k in range(n):
-            lane = grp[k]
-            Wf[ud + lane] = Wf[ub + lane]
-
-
-@njit(cache=True, error_model="numpy")
-def registers_to_zero(instrs, prog_offsets, R):
-    """For each program, the private registers it may read before writing them (a bit mask).
-
-    The scalar kernel zeroes all ``R`` registers before every program run; a register the
-    program writes before any read of it (its op code reads the target only for the
-    conditionals 14 and 15) never shows the old value, so only the registers read first,
-    and ``r[0]`` when the program never writes it (the bid), need the zero. With more than
-    63 registers every register is zeroed.
-    """
-    n_progs = len(prog_offsets) - 1
-    out = np.zeros(n_progs, dtype=np.uint64)
-    one = np.uint64(1)
-    for p in range(n_progs):
-        if R > 63:
-            out[p] = (one << np.uint64(63)) - one
-            continue
-        written = np.uint64(0)
-        need = np.uint64(0)
-        for i in range(prog_offsets[p], prog_offsets[p + 1]):
-            op, dst, a, b = instrs[i, 0], instrs[i, 1], instrs[i, 2], instrs[i, 3]
-            # what the op code reads: b always; a for the binary ops and the conditionals;
-            # the target for the conditionals
-            for src, read in (
-                (b, True),
-                (a, op <= 4 or op == 14 or op == 15),
-                (dst, op == 14 or op == 15),
-            ):
-                if read and src < R and not (written >> np.uint64(src)) & one:
-                    need |= one << np.uint64(src)
-            if dst < R:
-                written |= one << np.uint64(dst)
-        if not written & one:
-            need |= one  # the bid is r[0]
-        out[p] = need
-    return out
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -182,27 +77,34 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
         out: :class:`~mtpg.engine.batch.BatchResult`, written at each job's index.
         g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
     """
-    team_offsets, team_members, prog_offsets = g.team_offsets, g.team_members, g.prog_offsets
-    instrs, prog_action, prog_bank, prog_count = g.instrs, g.prog_action, g.prog_bank, g.prog_count
     R, M, base = g.n_registers, g.n_memory, g.mem_base
-    n_teams = len(team_offsets) - 1
-    n_banks = (prog_bank.max() + 1) if len(prog_bank) else 0
-    L = np.uint64(lanes)
-    n_addr = base + n_banks * M
-    Wf = np.zeros(n_addr * lanes)  # Wf[address * lanes + lane]
-    for i in range(N_CONSTANTS):
-        for k in range(lanes):
-            Wf[(R + i) * lanes + k] = _CONSTANTS[i]
+    n_teams = len(g.team_offsets) - 1
+    n_progs = len(g.prog_offsets) - 1
+    n_banks = (g.prog_bank.max() + 1) if n_progs else 0
     K = len(g.folded)
+    n_obs = base - K - (R + N_CONSTANTS)
+    L = np.uint64(lanes)
+    # the lane workspace (mtpg.engine.lane_graph): registers, observation and every bank a
+    # block could use, a row per value and a column per lane; then the shared constants
+    shared = (R + n_obs + n_banks * M) * lanes
+    Wf = np.zeros(shared + N_CONSTANTS + K)
+    for i in range(N_CONSTANTS):
+        Wf[shared + i] = _CONSTANTS[i]
     for i in range(K):
-        for k in range(lanes):
-            Wf[(base - K + i) * lanes + k] = g.folded[i]
-    u_obs = np.uint64(R + N_CONSTANTS) * L
-    u_base = np.uint64(base)
+        Wf[shared + N_CONSTANTS + i] = g.folded[i]
+    u_obs = np.uint64(R) * L
+    u_banks = np.uint64(R + n_obs) * L
     u_m = np.uint64(M)
-    zero_mask = registers_to_zero(instrs, prog_offsets, R)
-    visited = np.full(n_teams * lanes, -1, dtype=np.int64)  # [team * lanes + lane]
-    bank_stamp = np.full(n_banks, -1, dtype=np.int64)
+    # the block's local graph (lane_graph.localise)
+    maps = np.full((3, max(n_teams, n_progs, n_banks, 1)), -1, dtype=np.int64)
+    lteam = np.zeros(n_teams, dtype=np.int64)
+    lteam_off = np.zeros(n_teams + 1, dtype=np.int64)
+    lprog = np.zeros((len(g.team_members), 7), dtype=np.int64)
+    lcode = np.zeros((len(g.instrs), 6), dtype=np.uint64)
+    lbank = np.zeros(max(n_banks, 1), dtype=np.int64)
+    counts = np.zeros(4, dtype=np.int64)
+    roots = np.zeros(lanes, dtype=np.int64)
+    visited = np.full(n_teams * lanes, -1, dtype=np.int64)  # [local team * lanes + lane]
     state = np.zeros((lanes, STATE_SIZE))
     obs = np.zeros(2)
     # per lane
@@ -218,11 +120,11 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
     a_d = np.zeros(lanes, dtype=np.int64)
     a_c = np.zeros(lanes)
     live = np.zeros(lanes, dtype=np.int64)
+    start = np.zeros(lanes, dtype=np.int64)  # local root team of each lane
     pend_team = np.zeros(lanes, dtype=np.int64)
     pend_lane = np.zeros(lanes, dtype=np.int64)
     grp = np.zeros(lanes, dtype=np.uint64)
     stamp = 0
-    lane_block = 0
     n_jobs = len(jobs.roots)
     while True:
         first = _fetch_add(next_block) * block
@@ -231,12 +133,36 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
         last = min(first + block, n_jobs)
         for s in range(first, last, lanes):
             nl = min(lanes, last - s)
-            lane_block += 1
+            n_roots = 0
+            for k in range(nl):
+                r = jobs.roots[s + k]
+                if maps[0, r] < 0:  # a root not yet listed (marked until localise renumbers)
+                    maps[0, r] = 0
+                    roots[n_roots] = r
+                    n_roots += 1
+            for k in range(n_roots):
+                maps[0, roots[k]] = -1
+            localise(
+                g,
+                roots[:n_roots],
+                lanes,
+                shared,
+                maps,
+                lteam,
+                lteam_off,
+                lprog,
+                lcode,
+                lbank,
+                counts,
+            )
+            for i in range(u_banks, u_banks + np.uint64(counts[3]) * u_m * L):
+                Wf[i] = 0.0  # every bank of the block, every lane: each episode starts at 0
             for k in range(nl):
                 j = s + k
                 e = jobs.episodes[j]
                 p = table.params[table.tasks[e]]
                 job[k] = j
+                start[k] = maps[0, jobs.roots[j]]
                 kind[k] = np.int64(p[P_KIND])
                 okind[k] = observe_kind(p)
                 noisy[k] = p[P_OBS_SD] != 0.0
@@ -256,7 +182,7 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                 stamp += 1
                 # --- one decision for every live lane ---
                 for k in range(n_live):
-                    pend_team[k] = jobs.roots[job[live[k]]]
+                    pend_team[k] = start[live[k]]
                     pend_lane[k] = live[k]
                 n_pend = n_live
                 while n_pend > 0:
@@ -279,36 +205,32 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                         n_team[lane] += 1
                         best[lane] = -np.inf
                     team_ins = 0
-                    for kk in range(
-                        np.uint64(team_offsets[u_team]), np.uint64(team_offsets[u_team + 1])
-                    ):
-                        p = np.uint64(team_members[kk])
-                        bank = np.uint64(prog_bank[p])
-                        off = (u_base + bank * u_m) * L
-                        if no_memory:
+                    for q in range(lteam_off[u_team], lteam_off[u_team + np.uint64(1)]):
+                        row = lprog[q]
+                        if no_memory:  # the ablation: the program's bank zeroed first
+                            u_bank = np.uint64(row[P_BANK])
                             for r in range(u_m):
                                 for k in range(n):
-                                    Wf[off + r * L + grp[k]] = 0.0
-                        elif bank_stamp[bank] != lane_block:  # lazy reset, every lane at once
-                            for i in range(off, off + u_m * L):
-                                Wf[i] = 0.0
-                            bank_stamp[bank] = lane_block
-                        zm = zero_mask[p]
-                        r = np.uint64(0)
-                        while zm != 0:  # the private registers the program reads unwritten
-                            if zm & 1:
+                                    Wf[u_bank + r * L + grp[k]] = 0.0
+                        zm = row[P_ZERO]
+                        if zm == -1:  # every private register
+                            for r in range(np.uint64(R)):
                                 for k in range(n):
                                     Wf[r * L + grp[k]] = 0.0
-                            zm >>= np.uint64(1)
-                            r += np.uint64(1)
-                        for i in range(np.uint64(prog_offsets[p]), np.uint64(prog_offsets[p + 1])):
-                            op = instrs[i, 0]
-                            ud = np.uint64(instrs[i, 1]) * L
-                            ua = np.uint64(instrs[i, 2]) * L
-                            ub = np.uint64(instrs[i, 3]) * L
-                            lane_op(Wf, op, ud, ua, ub, grp, n)
-                        team_ins += prog_count[p]
-                        act = prog_action[p]
+                        else:  # the registers the program reads before writing them
+                            bits = np.uint64(zm)
+                            r = np.uint64(0)
+                            while bits != 0:
+                                if bits & np.uint64(1):
+                                    for k in range(n):
+                                        Wf[r * L + grp[k]] = 0.0
+                                bits >>= np.uint64(1)
+                                r += np.uint64(1)
+                        for i in range(row[P_LO], row[P_HI]):
+                            c = lcode[i]
+                            lane_op(Wf, c[C_OP], c[C_DST], c[C_A], c[C_MA], c[C_B], c[C_MB], grp, n)
+                        team_ins += row[P_COUNT]
+                        act = row[P_ACT]
                         # bids are finite, so starting from -inf the first eligible
                         # program wins and a later one only with a higher bid (ties: the
                         # earlier), as in the scalar kernel
@@ -317,22 +239,22 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                                 lane = grp[k]
                                 if Wf[lane] > best[lane]:
                                     best[lane] = Wf[lane]
-                                    best_p[lane] = np.int64(p)
+                                    best_p[lane] = q
                         else:
                             u_act = np.uint64(act) * L
                             for k in range(n):
                                 lane = grp[k]
                                 if visited[u_act + lane] != stamp and Wf[lane] > best[lane]:
                                     best[lane] = Wf[lane]
-                                    best_p[lane] = np.int64(p)
+                                    best_p[lane] = q
                     for k in range(n):
                         lane = grp[k]
                         n_ins[lane] += team_ins
-                        q = np.uint64(best_p[lane])
-                        act = prog_action[q]
+                        row = lprog[best_p[lane]]
+                        act = row[P_ACT]
                         if act < 0:
                             a_d[lane] = -1 - act
-                            a_c[lane] = Wf[(u_base + np.uint64(prog_bank[q]) * u_m) * L + lane]
+                            a_c[lane] = Wf[np.uint64(row[P_BANK]) + lane]
                         else:
                             pend_team[n_pend] = act
                             pend_lane[n_pend] = np.int64(lane)
@@ -364,6 +286,7 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                     live[m] = lane
                     m += 1
                 n_live = m
+            unlocalise(maps, lteam, lprog, lbank, counts)
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

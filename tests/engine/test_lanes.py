@@ -132,7 +132,7 @@ def test_a_block_graph_is_local_and_the_maps_are_left_clean():
     n_banks = int(g.prog_bank.max()) + 1
     maps = np.full((3, max(n_teams, n_progs, n_banks)), -1, dtype=np.int64)
     lteam, lteam_off = np.zeros(n_teams, np.int64), np.zeros(n_teams + 1, np.int64)
-    lprog = np.zeros((len(g.team_members), 7), np.int64)
+    lprog = np.zeros((len(g.team_members), 8), np.int64)
     lcode = np.zeros((len(g.instrs), 6), np.uint64)
     lbank, counts = np.zeros(n_banks, np.int64), np.zeros(4, np.int64)
     roots = np.array([0], dtype=np.int64)

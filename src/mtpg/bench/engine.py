@@ -24,6 +24,7 @@ import numpy as np
 
 from mtpg.bench.workload import Workload, drive, make_workload, warm_up
 from mtpg.engine.batch import BatchResult
+from mtpg.engine.lanes import DEFAULT_LANES
 from mtpg.engine.reference import ReferenceAgent, reference_episode
 from mtpg.envs import CARTPOLE
 from mtpg.model.graph import Population
@@ -282,7 +283,9 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, 
     return pairs
 
 
-def _time_engine(work: Workload, threads: int, repeats: int, say) -> tuple[list, list]:
+def _time_engine(
+    work: Workload, threads: int, repeats: int, say, lanes: int = DEFAULT_LANES
+) -> tuple[list, list]:
     """The timed compiled runs, and above one thread the one-thread run paired with each.
 
     Raises:
@@ -291,8 +294,8 @@ def _time_engine(work: Workload, threads: int, repeats: int, say) -> tuple[list,
     runs, singles = [], []
     for r in range(repeats):
         if threads > 1:  # the scaling: one-thread runs interleaved with the N-thread runs
-            singles.append(drive(work, 1))
-        res = drive(work, threads)
+            singles.append(drive(work, 1, lanes))
+        res = drive(work, threads, lanes)
         runs.append(res)
         say(
             f"  run {r + 1}/{repeats}: {res.decisions / res.seconds:,.0f} decisions/s"
@@ -321,7 +324,9 @@ def _checked_reference(work: Workload, engine: BatchResult, graphs: int, say):
     return ref
 
 
-def _time_c(work: Workload, engine: BatchResult, repeats: int, say, c_flags, c_beside):
+def _time_c(
+    work: Workload, engine: BatchResult, repeats: int, say, c_flags, c_beside, lanes=DEFAULT_LANES
+):
     """The C builds asked for (:func:`_c_runs`): the main flags, then those beside."""
     say("the same work in C (interleaved with one-thread engine runs) ...")
     from mtpg.bench.c_port import C_FLAGS, C_FLAGS_BESIDE
@@ -329,7 +334,7 @@ def _time_c(work: Workload, engine: BatchResult, repeats: int, say, c_flags, c_b
     c_flags = tuple(c_flags) if c_flags else C_FLAGS
     c_beside = C_FLAGS_BESIDE if c_beside is None else tuple(c_beside)
     builds = [c_flags] + ([c_beside] if c_beside and c_beside != c_flags else [])
-    return _c_runs(work, engine, repeats, say, lambda: drive(work, 1), builds)
+    return _c_runs(work, engine, repeats, say, lambda: drive(work, 1, lanes), builds)
 
 
 def _summary(work: Workload, runs: list, threads: int, ref: ReferenceRun | None, pt) -> dict:
@@ -418,6 +423,7 @@ def benchmark(
     c_flags: tuple[str, ...] | None = None,
     c_beside: tuple[str, ...] | None = None,
     log=None,
+    lanes: int = DEFAULT_LANES,
 ) -> dict:
     """Runs the whole benchmark.
 
@@ -442,6 +448,8 @@ def benchmark(
         c_beside: Flags of a second C build reported beside it (default
             ``c_port.C_FLAGS_BESIDE``; an empty tuple for none).
         log: Called with progress lines (``None``: silent).
+        lanes: Lane-block size of the engine's runs (0: the scalar kernel, the like for
+            like of the scalar C port).
 
     Returns:
         The figures (see ``mtpg bench engine``).
@@ -455,7 +463,7 @@ def benchmark(
     warm_up(threads)
     say(f"building {graphs} graphs ...")
     work = make_workload(graphs, teams, programs, instructions, episodes, seed)
-    runs, singles = _time_engine(work, threads, repeats, say)
+    runs, singles = _time_engine(work, threads, repeats, say, lanes)
     first = runs[0].result
     record = min(reference_graphs, graphs)
     ref = _checked_reference(work, first, record, say) if record else None
@@ -463,9 +471,9 @@ def benchmark(
     if pytpg and ref is not None:
         say(f"pytpg on {record} graphs ...")
         pt = run_pytpg(work, ref, seed)
-    c_pairs = _time_c(work, first, repeats, say, c_flags, c_beside) if c else None
+    c_pairs = _time_c(work, first, repeats, say, c_flags, c_beside, lanes) if c else None
     out = _summary(work, runs, threads, ref, pt)
-    out.update(reference_graphs=record, seed=seed, machine=machine_info())
+    out.update(reference_graphs=record, seed=seed, machine=machine_info(), lanes=lanes)
     if singles:
         out.update(_scaling(runs, singles))
     if c_pairs is not None:

@@ -72,7 +72,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         " interleaved, one thread, process CPU time",
     )
     eng.add_argument(
-        "--lanes", type=int, default=32, help="lane-block size of --late (32, the engine's)"
+        "--lanes",
+        type=int,
+        default=32,
+        help="lane-block size of the engine (32, the default of training; 0: the scalar"
+        " kernel, one job at a time, the like for like of the scalar C port)",
     )
     eng.set_defaults(func=run)
     bench.set_defaults(func=lambda _args: _help(bench))
@@ -145,6 +149,7 @@ def run(args: argparse.Namespace) -> int:
         c_flags=tuple(args.c_flags.split()),
         c_beside=tuple(args.c_beside.split()),
         log=log,
+        lanes=args.lanes,
     )
     m = r["machine"]
     speed_ref = r["speedup_vs_reference"]
@@ -154,7 +159,8 @@ def run(args: argparse.Namespace) -> int:
         f"mtpg engine benchmark ({m['cpu']}, {m['cores']} cores, numba {m['numba']})",
         f"  workload      {r['graphs']} graphs x {r['teams']} teams x {r['programs']} programs"
         f" x {r['instructions']} instructions, {r['pointer_fraction']:.1%} pointers,"
-        f" {r['episodes']} CartPole episodes each",
+        f" {r['episodes']} CartPole episodes each; engine: "
+        + (f"lane engine, {r['lanes']} lanes" if r["lanes"] else "scalar kernel"),
         f"  compiled      {_fmt(r['decisions_per_s'])} decisions/s on {r['threads']} thread(s)"
         f" (median of {r['repeats']}: {r['seconds']:.3f} s for {r['decisions']:,} decisions,"
         " environment included)",

@@ -24,7 +24,7 @@ from numba import njit
 from mtpg.model.instructions import N_CONSTANTS
 
 #: Columns of a program row of the local table.
-P_LO, P_HI, P_ACT, P_BANK, P_COUNT, P_ZERO, P_GLOBAL = range(7)
+P_LO, P_HI, P_ACT, P_BANK, P_COUNT, P_ZERO, P_GLOBAL, P_LBANK = range(8)
 #: Columns of a translated instruction: op code, target, operands and their lane masks.
 C_OP, C_DST, C_A, C_MA, C_B, C_MB = range(6)
 
@@ -102,7 +102,7 @@ def localise(g, roots, lanes, shared, maps, lteam, lteam_off, lprog, lcode, lban
         lteam: int64: local team -> global team (written).
         lteam_off: int64: the programs of local team ``t`` are rows
             ``lteam_off[t]:lteam_off[t + 1]`` of ``lprog`` (written).
-        lprog: int64 ``[len(team_members), 7]``: program rows (``P_*`` columns; the action
+        lprog: int64 ``[len(team_members), 8]``: program rows (``P_*`` columns; the action
             as ``-1 - a`` or a local team; the bank as the workspace index of its row 0).
         lcode: uint64 ``[n_instructions, 6]``: translated code (``C_*`` columns).
         lbank: int64: local bank -> global bank (written).
@@ -162,6 +162,7 @@ def localise(g, roots, lanes, shared, maps, lteam, lteam_off, lprog, lcode, lban
                 np.int64(registers_to_zero(g.instrs, lo, hi, R)) if R <= 64 else -1
             )
             lprog[n_lp, P_GLOBAL] = p
+            lprog[n_lp, P_LBANK] = bank
             n_lp += 1
     lteam_off[n_lt] = n_lp
     counts[0], counts[1], counts[2], counts[3] = n_lt, n_lp, n_lc, n_lb[0]

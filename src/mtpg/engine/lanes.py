@@ -41,6 +41,7 @@ from mtpg.engine.lane_graph import (
     P_BANK,
     P_COUNT,
     P_HI,
+    P_LBANK,
     P_LO,
     P_ZERO,
     localise,
@@ -93,13 +94,12 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
     for i in range(K):
         Wf[shared + N_CONSTANTS + i] = g.folded[i]
     u_obs = np.uint64(R) * L
-    u_banks = np.uint64(R + n_obs) * L
     u_m = np.uint64(M)
     # the block's local graph (lane_graph.localise)
     maps = np.full((3, max(n_teams, n_progs, n_banks, 1)), -1, dtype=np.int64)
     lteam = np.zeros(n_teams, dtype=np.int64)
     lteam_off = np.zeros(n_teams + 1, dtype=np.int64)
-    lprog = np.zeros((len(g.team_members), 7), dtype=np.int64)
+    lprog = np.zeros((len(g.team_members), 8), dtype=np.int64)
     lcode = np.zeros((len(g.instrs), 6), dtype=np.uint64)
     lbank = np.zeros(max(n_banks, 1), dtype=np.int64)
     counts = np.zeros(4, dtype=np.int64)
@@ -124,6 +124,8 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
     pend_team = np.zeros(lanes, dtype=np.int64)
     pend_lane = np.zeros(lanes, dtype=np.int64)
     grp = np.zeros(lanes, dtype=np.uint64)
+    bank_mark = np.zeros(max(n_banks, 1), dtype=np.int64)  # block of a local bank's zeroing
+    n_blocks = 0
     stamp = 0
     n_jobs = len(jobs.roots)
     while True:
@@ -155,8 +157,7 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                 lbank,
                 counts,
             )
-            for i in range(u_banks, u_banks + np.uint64(counts[3]) * u_m * L):
-                Wf[i] = 0.0  # every bank of the block, every lane: each episode starts at 0
+            n_blocks += 1  # the block's mark: its banks are zeroed when first used
             for k in range(nl):
                 j = s + k
                 e = jobs.episodes[j]
@@ -207,11 +208,17 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
                     team_ins = 0
                     for q in range(lteam_off[u_team], lteam_off[u_team + np.uint64(1)]):
                         row = lprog[q]
+                        u_bank = np.uint64(row[P_BANK])
                         if no_memory:  # the ablation: the program's bank zeroed first
-                            u_bank = np.uint64(row[P_BANK])
                             for r in range(u_m):
                                 for k in range(n):
                                     Wf[u_bank + r * L + grp[k]] = 0.0
+                        elif bank_mark[row[P_LBANK]] != n_blocks:
+                            # first use in this block, where every lane's episode began:
+                            # zeroed for every lane, as at each episode's start
+                            for i in range(u_bank, u_bank + u_m * L):
+                                Wf[i] = 0.0
+                            bank_mark[row[P_LBANK]] = n_blocks
                         zm = row[P_ZERO]
                         if zm == -1:  # every private register
                             for r in range(np.uint64(R)):

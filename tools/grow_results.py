@@ -6,7 +6,8 @@ grow over many sittings, machines and commits. Each call of this script::
 
     .venv/bin/python tools/grow_results.py --budget 150          # minutes
 
-continues the unfinished runs of :data:`PLAN` in order, ``--parallel`` at a time, each an
+continues the unfinished runs of :data:`PLAN` (or, with ``--plan demo``, of
+:data:`DEMO_PLAN` in ``results/candidates``) in order, ``--parallel`` at a time, each an
 ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun). Every
 ``--slice`` minutes, and when the budget is spent or the script is stopped (SIGTERM,
 SIGINT, SIGHUP), the runs are sent SIGTERM, so each commits the generation under way and
@@ -50,6 +51,17 @@ PLAN: tuple[tuple[str, int, str | None], ...] = (
     ("TPG-NoMemory-seed1", 1, "no-memory"),
     ("TPG-NoHierarchy-seed1", 1, "no-hierarchy"),
 )
+#: The demo-scale candidates for the memorisation study (issue 40): six tasks, 1,000
+#: generations, five seeds of ``demo`` as it is and with the training episodes redrawn
+#: every 10 generations (``robust``'s rule), in ``results/candidates`` (``--plan demo``).
+DEMO_PLAN: tuple[tuple[str, int, str | None], ...] = (
+    *((f"demo-seed{s}", s, None) for s in range(1, 6)),
+    *((f"demo-resample10-seed{s}", s, "resample10") for s in range(1, 6)),
+)
+#: Each plan: its preset, and where its runs go unless ``--results`` says otherwise.
+PLANS = {"paper": ("paper", "results"), "demo": ("demo", "results/candidates")}
+#: What a plan entry's variant adds to ``mtpg train`` (any other: ``--VARIANT``).
+VARIANT_ARGS = {"resample10": ["--set", "evaluation.resample_interval=10"]}
 #: Test-point folders kept: generations divisible by this, and the newest.
 KEEP_TESTS_EVERY = 100
 #: Seconds a run is given to commit after SIGTERM before it is told to stop at once.
@@ -140,8 +152,9 @@ def start(name: str, seed: int, ablation: str | None, args: argparse.Namespace) 
     if (path / "config.toml").is_file():
         cmd = ["train", "--resume", str(path), *common]
     else:
-        flag = [f"--{ablation}"] if ablation else []
-        cmd = ["train", "--preset", "paper", "--seed", str(seed), *flag, *common]
+        flag = VARIANT_ARGS.get(ablation, [f"--{ablation}"]) if ablation else []
+        preset = PLANS[args.plan][0]
+        cmd = ["train", "--preset", preset, "--seed", str(seed), *flag, *common]
         cmd += [*args.train_arg, "--out", str(path)]
     log = open(args.results / "runs" / f"{name}.log", "a")
     proc = subprocess.Popen(
@@ -265,7 +278,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--workers", type=int, default=1, help="threads per run (1)")
     p.add_argument("--generations", type=int, default=1000, help="target (1000)")
     p.add_argument("--python", default=sys.executable, help="interpreter whose mtpg runs")
-    p.add_argument("--results", type=Path, default=Path("results"), help="folder (results)")
+    p.add_argument(
+        "--plan",
+        choices=sorted(PLANS),
+        default="paper",
+        help="the paper's experiment (paper) or the demo-scale candidates (demo)",
+    )
+    p.add_argument(
+        "--results", type=Path, default=None, help="folder (results; demo: results/candidates)"
+    )
     p.add_argument("--no-commit", action="store_true", help="tidy and record, commit nothing")
     p.add_argument(
         "--train-arg",
@@ -280,7 +301,9 @@ def main(argv: list[str] | None = None) -> int:
         help="skip the clean-checkout checks (trials only; provenance then says so)",
     )
     args = p.parse_args(argv)
-    args.results = args.results.resolve()
+    args.results = (args.results or Path(PLANS[args.plan][1])).resolve()
+    plan = PLAN if args.plan == "paper" else DEMO_PLAN
+    args.results.mkdir(parents=True, exist_ok=True)
     repo = Path(sh("git", "rev-parse", "--show-toplevel", cwd=args.results))
     commit = "unchecked" if args.unchecked else source_commit(args.python, repo)
     (args.results / "runs").mkdir(parents=True, exist_ok=True)
@@ -299,7 +322,7 @@ def main(argv: list[str] | None = None) -> int:
         runs = args.results / "runs"
         return [
             r
-            for r in PLAN
+            for r in plan
             if r[0] not in failed and last_generation(runs / r[0]) < args.generations
         ]
 

@@ -92,3 +92,25 @@ def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypa
     assert len(log) >= 2 and log[0].startswith("results: grow")
     tracked = _git(repo, "ls-files").stdout
     assert ".lock" not in tracked and ".log" not in tracked
+
+
+def test_the_demo_plan_starts_demo_runs_with_and_without_resampling(tmp_path, monkeypatch):
+    tool = _tool()
+    started = []
+
+    class FakePopen:
+        def __init__(self, cmd, **_kw):
+            started.append(cmd)
+
+    monkeypatch.setattr(tool.subprocess, "Popen", FakePopen)
+    (tmp_path / "runs").mkdir()
+    args = tool.argparse.Namespace(
+        results=tmp_path, generations=1000, workers=1, train_arg=[], python="py", plan="demo"
+    )
+    for name, seed, variant in tool.DEMO_PLAN:
+        tool.start(name, seed, variant, args)
+    assert len(started) == 10 and {c[c.index("--seed") + 1] for c in started} == set("12345")
+    assert all(c[c.index("--preset") + 1] == "demo" for c in started)
+    resampled = [c for c in started if "evaluation.resample_interval=10" in c]
+    assert len(resampled) == 5
+    assert all("resample10" in c[c.index("--out") + 1] for c in resampled)

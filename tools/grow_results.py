@@ -54,9 +54,10 @@ PLAN: tuple[tuple[str, int, str | None], ...] = (
 #: The demo-scale candidates for the memorisation study (issue 40): six tasks, 1,000
 #: generations, five seeds of ``demo`` as it is and with the training episodes redrawn
 #: every 10 generations (``robust``'s rule), in ``results/candidates`` (``--plan demo``).
-DEMO_PLAN: tuple[tuple[str, int, str | None], ...] = (
-    *((f"demo-seed{s}", s, None) for s in range(1, 6)),
-    *((f"demo-resample10-seed{s}", s, "resample10") for s in range(1, 6)),
+DEMO_PLAN: tuple[tuple[str, int, str | None], ...] = tuple(
+    run
+    for s in range(1, 6)  # seed by seed, so that the pairs to compare grow together
+    for run in ((f"demo-seed{s}", s, None), (f"demo-resample10-seed{s}", s, "resample10"))
 )
 #: Each plan: its preset, and where its runs go unless ``--results`` says otherwise.
 PLANS = {"paper": ("paper", "results"), "demo": ("demo", "results/candidates")}

@@ -1,0 +1,43 @@
+"""The lane engine's machine code calls the scalar math library, never a vector one.
+
+Every lane must compute what the scalar kernel computes, bit for bit. A vector math
+library (Numba's SVML, when Intel's ``icc_rt`` is installed) computes ``cos`` and the
+others to other bits, so the lane loops must not be vectorised into it. The check
+compiles the lane kernel in a fresh process with an empty cache and reads its assembly.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+SCRIPT = """
+import json
+import numpy as np
+from mtpg.engine.batch import BatchResult, Episodes, Jobs
+from mtpg.engine.compile import compile_population
+from mtpg.engine.lanes import run_lanes_queue
+from mtpg.engine.workload import tangled_population
+pop = tangled_population(np.random.default_rng(0), 3, 10, 8, 3, 0.5)
+cp = compile_population(pop)
+eps = Episodes.grid([0, 3], [0])
+roots = np.array([cp.team_index(r) for r in pop.roots()][:1] * 2, dtype=np.int64)
+out = BatchResult.zeros(2)
+run_lanes_queue(np.zeros(1, np.int64), 2, 4, Jobs(roots, np.arange(2)), eps, False, out, cp.graph)
+(sig,) = run_lanes_queue.signatures
+asm = run_lanes_queue.inspect_asm(sig)
+print(json.dumps([len(asm), asm.lower().count("svml"), asm.count("cos")]))
+"""
+
+
+def test_lane_kernel_uses_no_vector_math_library(tmp_path):
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    done = subprocess.run(
+        [sys.executable, "-c", SCRIPT], env=env, capture_output=True, text=True, check=True
+    )
+    size, svml, cos = json.loads(done.stdout.strip().splitlines()[-1])
+    assert size > 10_000, "no machine code shown"
+    assert svml == 0
+    assert cos > 0  # the scalar call is there

@@ -1,0 +1,101 @@
+"""Score the demo-scale candidates of ``results/candidates`` and write their table.
+
+For every run of the demo plan (``tools/grow_results.py --plan demo``) that has reached
+its last generation, the all-task champion is played on 100 held-out episodes per task
+(``mtpg evaluate RUN --episodes 100 --json``: seeds 1,000,000 to 1,000,099, never used by
+training or selection). The normalised scores (0 = random play, 1 = the reference best)
+go to ``results/candidates/candidates.json``, and the README's section between the
+markers below gets the table: per run and task, then per group the interquartile mean
+over runs and tasks with its 95% stratified bootstrap interval, per task the IQM over
+runs, and the probability that a resampled run beats a plain one on a task, with its
+interval (:mod:`mtpg.analysis.runs.statistics`).
+
+    .venv/bin/python tools/candidates_readme.py
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from mtpg.analysis.runs.statistics import aggregate_iqm, per_task_iqm, probability_of_improvement
+
+ROOT = Path(__file__).resolve().parent.parent
+FOLDER = ROOT / "results" / "candidates"
+GROUPS = {"demo": "demo-seed", "demo-resample10": "demo-resample10-seed"}
+EPISODES = 100
+BEGIN, END = "<!-- candidates table: begin -->", "<!-- candidates table: end -->"
+
+
+def finished(run: Path) -> bool:
+    """Whether the run has reached the generations of its configuration."""
+    target = tomllib.loads((run / "config.toml").read_text())["generations"]
+    lines = (run / "metrics.csv").read_text().splitlines()
+    return len(lines) > 1 and int(lines[-1].split(",")[0]) >= target
+
+
+def scores(run: Path) -> dict[str, float]:
+    """The all-task champion's normalised score per task on the held-out episodes."""
+    out = subprocess.run(
+        [sys.executable, "-m", "mtpg", "evaluate", str(run), "--episodes", str(EPISODES)]
+        + ["--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    return {task: row["normalised"] for task, row in json.loads(out).items()}
+
+
+def table(results: dict[str, dict[str, dict[str, float]]]) -> str:
+    """The README section: per run, per group and the pairwise comparison."""
+    tasks = list(next(iter(next(iter(results.values())).values())))
+    head = "| run | " + " | ".join(tasks) + " | min |\n|---|" + "---|" * (len(tasks) + 1)
+    lines = [head]
+    matrices = {}
+    for group, runs in results.items():
+        matrices[group] = np.array([[runs[r][t] for t in tasks] for r in sorted(runs)])
+        for r in sorted(runs):
+            row = [runs[r][t] for t in tasks]
+            lines.append(f"| {r} | " + " | ".join(f"{v:.2f}" for v in row) + f" | {min(row):.2f} |")
+    lines += ["", "| group | runs | IQM over runs and tasks [95% CI] | " + " | ".join(tasks) + " |"]
+    lines.append("|---|---|---|" + "---|" * len(tasks))
+    for group, m in matrices.items():
+        per = " | ".join(e.text() for e in per_task_iqm(m))
+        lines.append(f"| {group} | {len(m)} | {aggregate_iqm(m).text()} | {per} |")
+    if all(len(m) for m in matrices.values()) and len(matrices) == 2:
+        a, b = matrices["demo-resample10"], matrices["demo"]
+        lines += ["", f"P(demo-resample10 > demo) = {probability_of_improvement(a, b).text()}"]
+    return "\n".join(lines)
+
+
+def main() -> int:
+    """Scores the finished runs and rewrites the README's table; returns the exit status."""
+    results: dict[str, dict[str, dict[str, float]]] = {}
+    for group, prefix in GROUPS.items():
+        runs = sorted((FOLDER / "runs").glob(f"{prefix}[0-9]*"))
+        results[group] = {r.name: scores(r) for r in runs if finished(r)}
+        print(f"{group}: {len(results[group])} of {len(runs)} runs finished", flush=True)
+    if not any(results.values()):
+        print("no finished run", file=sys.stderr)
+        return 1
+    (FOLDER / "candidates.json").write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
+    readme = FOLDER / "README.md"
+    text = readme.read_text()
+    head, _, rest = text.partition(BEGIN)
+    _, _, tail = rest.partition(END)
+    body = (
+        f"{BEGIN}\nNormalised scores on {EPISODES} held-out episodes per task of each finished "
+        "run's all-task champion (written by `tools/candidates_readme.py`):\n\n"
+        f"{table(results)}\n{END}"
+    )
+    readme.write_text(head + body + tail)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -19,8 +19,8 @@ from mtpg.envs.reference import give_reference, parse_given
 from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
 from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
 from mtpg.limits import LIMITS
+from mtpg.presets import BACKENDS, PARENT_SELECTIONS, PRESETS
 from mtpg.presets import EXTENSIONS as EXTENSIONS
-from mtpg.presets import PARENT_SELECTIONS, PRESETS
 
 
 class ConfigError(ValueError):
@@ -289,7 +289,7 @@ class RunConfig:
         _positive(self, "run", ("generations",))  # 0 would leave a run without a champion
         _positive(self, "run", ("workers", "checkpoint_interval"))
         _positive(self, "run", ("dask_workers",), minimum=0)
-        _check(self.backend in ("local", "dask"), "backend", "must be local or dask", self.backend)
+        _check(self.backend in BACKENDS, "backend", "must be local or dask", self.backend)
         # whether backend dask has an address or workers is checked when the run starts
         # (mtpg.evolve.backend.make_evaluator): overrides arrive one field at a time
 

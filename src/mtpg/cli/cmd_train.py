@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from mtpg.ablations import ABLATION_TABLE
-from mtpg.presets import PRESETS
+from mtpg.presets import BACKENDS, PRESETS
 
 
 def preset_help() -> str:
@@ -44,7 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--backend",
-        choices=("local", "dask"),
+        choices=BACKENDS,
         help="evaluate on this machine's threads (local) or a Dask cluster (dask)",
     )
     p.add_argument("--address", metavar="TCP://HOST:PORT", help="scheduler of a Dask cluster")

@@ -441,3 +441,23 @@ def test_a_reference_source_with_odd_characters_trains_resumes_and_reports(tmp_p
     assert done.returncode == 0, done.stderr
     done = mtpg("report", str(run), "--out", str(tmp_path / "report"))
     assert done.returncode == 0, done.stderr
+
+
+def test_fields_are_coerced_by_their_type_hints_optional_included() -> None:
+    from dataclasses import dataclass
+
+    from mtpg.config import _apply
+
+    @dataclass(frozen=True)
+    class Section:
+        limit: int | None = None
+        names: tuple[str, ...] = ()
+        rate: float = 0.5
+
+    assert _apply(Section(), {"limit": 3, "rate": 1}, "s.") == Section(3, (), 1.0)
+    assert _apply(Section(3), {"limit": None}, "s.") == Section(None)
+    assert _apply(Section(), {"names": ["a", "b"]}, "s.").names == ("a", "b")
+    with pytest.raises(ConfigError, match=r"^s\.limit must be int \| None, got str 'x'$"):
+        _apply(Section(), {"limit": "x"}, "s.")
+    with pytest.raises(ConfigError, match=r"^s\.limit must be int \| None, got bool True$"):
+        _apply(Section(), {"limit": True}, "s.")

@@ -140,27 +140,14 @@ def _fresh_dir(base: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs the command, with ``--scheduler-wait`` in force (and put back) around it."""
-    import os
-
+    """Runs the command; ``--scheduler-wait`` is checked here and given to the run's session."""
     from mtpg.cli.main import UsageError
-    from mtpg.engine.dask_backend import SCHEDULER_WAIT_ENV
 
-    if args.scheduler_wait is None:
-        return _train(args)
-    if not 0 < args.scheduler_wait <= 3600:
+    if args.scheduler_wait is not None and not 0 < args.scheduler_wait <= 3600:
         raise UsageError(
             f"--scheduler-wait must be in (0, 3600] seconds, got {args.scheduler_wait}"
         )
-    old = os.environ.get(SCHEDULER_WAIT_ENV)
-    os.environ[SCHEDULER_WAIT_ENV] = repr(args.scheduler_wait)
-    try:
-        return _train(args)
-    finally:
-        if old is None:
-            del os.environ[SCHEDULER_WAIT_ENV]
-        else:
-            os.environ[SCHEDULER_WAIT_ENV] = old
+    return _train(args)
 
 
 def _train(args: argparse.Namespace) -> int:
@@ -186,11 +173,11 @@ def _train(args: argparse.Namespace) -> int:
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
             config = merge_overrides(read_run_config(args.resume, resuming=True), overrides(args))
-            session = Session(args.resume, config, resume=True)
+            session = Session(args.resume, config, resume=True, scheduler_wait=args.scheduler_wait)
         else:
             config = build_config(args.preset, args.config, overrides(args))
             out = args.out or _fresh_dir(f"runs/{args.preset}-seed{config.seed}")
-            session = Session(out, config)
+            session = Session(out, config, scheduler_wait=args.scheduler_wait)
         cfg, where = session.config, session.run.path
         print(
             f"run directory: {where}  (generation {session.trainer.state.generation}"

@@ -6,17 +6,8 @@ import argparse
 import sys
 
 from mtpg.ablations import ABLATION_TABLE
-from mtpg.presets import BACKENDS, PRESETS
-
-
-def preset_help() -> str:
-    """The help of ``--preset``: every preset by name, as :data:`mtpg.presets.PRESETS` has them."""
-    names = list(PRESETS)
-    listed = ", ".join(names[:-1]) + " or " + names[-1]
-    return (
-        f"configuration preset: {listed} (robust = paper with the training episodes redrawn "
-        "every 10 generations; default: demo)"
-    )
+from mtpg.cli.common import overrides, preset_help
+from mtpg.presets import BACKENDS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -83,49 +74,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "default; not stored with the run)",
     )
     p.set_defaults(func=run)
-
-
-def task_list(text: str, option: str = "--tasks") -> list[str]:
-    """The canonical names of a comma-separated list option, refusing an empty one.
-
-    Commas inside a variant's brackets do not split (``CartPole[max_steps=500],Pendulum``);
-    each name is checked and spelled canonically (``mtpg.envs.variants.canonical``).
-    """
-    from mtpg.cli.main import UsageError
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.variants import canonical, is_variant
-
-    parts, depth, word = [], 0, ""
-    for ch in text:
-        depth += {"[": 1, "]": -1}.get(ch, 0)
-        if ch == "," and depth <= 0:
-            parts.append(word)
-            word = ""
-        else:
-            word += ch
-    names = [t.strip() for t in [*parts, word] if t.strip()]
-    if not names:
-        raise UsageError(f"{option}: empty list; name at least one of {', '.join(TASK_NAMES)}")
-    try:  # a plain unknown name is left to the configuration's check, which names the field
-        return [canonical(t) if is_variant(t) else t for t in names]
-    except ValueError as exc:
-        raise UsageError(f"{option}: {exc}") from None
-
-
-def overrides(args: argparse.Namespace) -> list[str]:
-    """The ``section.field=value`` overrides the options stand for."""
-    out = list(args.set)
-    if args.tasks is not None:
-        names = task_list(args.tasks)
-        out.append("evaluation.tasks=[" + ", ".join(f'"{t}"' for t in names) + "]")
-    for key in ("generations", "seed", "workers", "dask_workers"):
-        if getattr(args, key) is not None:
-            out.append(f"{key}={getattr(args, key)}")
-    for key in ("backend", "address"):
-        if getattr(args, key) is not None:
-            out.append(f'{key}="{getattr(args, key)}"')
-    out += [abl.override for abl in ABLATION_TABLE if getattr(args, abl.dest)]
-    return out
 
 
 def _fresh_dir(base: str) -> str:

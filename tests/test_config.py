@@ -400,3 +400,64 @@ def test_settings_file_is_read_with_a_bounded_read(tmp_path, monkeypatch) -> Non
     monkeypatch.setattr(config_module, "open", lambda *a, **k: Endless(), raising=False)
     message = _read_error(tmp_path / "endless.toml")
     assert message.endswith("bytes; not a settings file")
+
+
+def test_toml_strings_round_trip_every_control_character() -> None:
+    import tomllib
+
+    from mtpg.config import _toml_value
+
+    texts = ["".join(map(chr, range(0x80))), 'a"b\\c\td\ne\r\x7f', "π ≠ 3 \u2028", ""]
+    for text in texts:
+        assert tomllib.loads(f"x = {_toml_value(text)}")["x"] == text
+    assert tomllib.loads(f"x = {_toml_value(tuple(texts))}")["x"] == texts
+
+
+def test_a_reference_source_with_odd_characters_trains_resumes_and_reports(tmp_path) -> None:
+    """A [[task]] reference source with a newline, a quote, a backslash and a tab."""
+    import tomllib
+
+    from stopruns import mtpg
+    from tinyruns import tiny_overrides
+
+    source = 'line one\nsaid "x" \\ y\tz'
+    escaped = source.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+    conf = tmp_path / "run.toml"
+    conf.write_text(
+        '[[task]]\nbase = "CartPole"\nmax_steps = 401\n'
+        f'reference = {{ best = 401, random = 21.0, source = "{escaped}" }}\n'
+        '[[task]]\nbase = "Acrobot"\n'
+    )
+    run = tmp_path / "run"
+    sets = [a for t in tiny_overrides(12, 2, checkpoint_interval=1) for a in ("--set", t)]
+    common = ["--quiet", *sets]
+    done = mtpg("train", "--config", str(conf), *common, "--generations", "2", "--out", str(run))
+    assert done.returncode == 0, done.stderr
+    stored = tomllib.loads((run / "config.toml").read_text())
+    assert stored["evaluation"]["references"] == [
+        f"CartPole[max_steps=401]: best=401, random=21.0, source={source}"
+    ]
+    done = mtpg("train", "--resume", str(run), "--quiet", "--generations", "3")
+    assert done.returncode == 0, done.stderr
+    done = mtpg("report", str(run), "--out", str(tmp_path / "report"))
+    assert done.returncode == 0, done.stderr
+
+
+def test_fields_are_coerced_by_their_type_hints_optional_included() -> None:
+    from dataclasses import dataclass
+
+    from mtpg.config import _apply
+
+    @dataclass(frozen=True)
+    class Section:
+        limit: int | None = None
+        names: tuple[str, ...] = ()
+        rate: float = 0.5
+
+    assert _apply(Section(), {"limit": 3, "rate": 1}, "s.") == Section(3, (), 1.0)
+    assert _apply(Section(3), {"limit": None}, "s.") == Section(None)
+    assert _apply(Section(), {"names": ["a", "b"]}, "s.").names == ("a", "b")
+    with pytest.raises(ConfigError, match=r"^s\.limit must be int \| None, got str 'x'$"):
+        _apply(Section(), {"limit": "x"}, "s.")
+    with pytest.raises(ConfigError, match=r"^s\.limit must be int \| None, got bool True$"):
+        _apply(Section(), {"limit": True}, "s.")

@@ -9,7 +9,10 @@ overrides; each step validates and names the offending field on error.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import tomllib
+import types
+import typing
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
@@ -19,8 +22,8 @@ from mtpg.envs.reference import give_reference, parse_given
 from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
 from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
 from mtpg.limits import LIMITS
+from mtpg.presets import BACKENDS, PARENT_SELECTIONS, PRESETS
 from mtpg.presets import EXTENSIONS as EXTENSIONS
-from mtpg.presets import PARENT_SELECTIONS, PRESETS
 
 
 class ConfigError(ValueError):
@@ -289,7 +292,7 @@ class RunConfig:
         _positive(self, "run", ("generations",))  # 0 would leave a run without a champion
         _positive(self, "run", ("workers", "checkpoint_interval"))
         _positive(self, "run", ("dask_workers",), minimum=0)
-        _check(self.backend in ("local", "dask"), "backend", "must be local or dask", self.backend)
+        _check(self.backend in BACKENDS, "backend", "must be local or dask", self.backend)
         # whether backend dask has an address or workers is checked when the run starts
         # (mtpg.evolve.backend.make_evaluator): overrides arrive one field at a time
 
@@ -310,19 +313,47 @@ class RunConfig:
 _SECTIONS = {"program": ProgramConfig, "team": TeamConfig, "evaluation": EvaluationConfig}
 
 
-def _coerce(name: str, ftype: Any, value: Any) -> Any:
-    """Checks ``value`` against the field type; ints are accepted for floats."""
-    expected = {"int": int, "float": float, "bool": bool, "str": str, "tuple[str, ...]": tuple}[
-        str(ftype)
-    ]
-    if expected is float and isinstance(value, int) and not isinstance(value, bool):
-        return float(value)
-    if expected is tuple and isinstance(value, list | tuple):
-        if all(isinstance(v, str) for v in value):
+@functools.cache
+def _hints(cls: type) -> dict[str, Any]:
+    """The resolved type of each field of a configuration class."""
+    return typing.get_type_hints(cls)
+
+
+def _coerce(name: str, hint: Any, value: Any, spelled: str) -> Any:
+    """Checks ``value`` against the field's type ``hint``; ints are accepted for floats.
+
+    Args:
+        name: The field's dotted name (for the message).
+        hint: Its resolved type: ``int``, ``float``, ``bool``, ``str``, ``tuple[T, ...]``
+            or a union of these with ``None``.
+        value: The value given.
+        spelled: The type as the class spells it (for the message).
+
+    Raises:
+        ConfigError: Naming the field, its type and the value.
+    """
+    args = typing.get_args(hint)
+    if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union:
+        if value is None and type(None) in args:
+            return None
+        for arg in args:
+            if arg is not type(None):
+                try:
+                    return _coerce(name, arg, value, spelled)
+                except ConfigError:
+                    pass
+    elif typing.get_origin(hint) is tuple:
+        if isinstance(value, list | tuple) and all(
+            isinstance(v, args[0]) and not isinstance(v, bool) for v in value
+        ):
             return tuple(value)
-    elif isinstance(value, expected) and (expected is bool or not isinstance(value, bool)):
+    elif hint is float and isinstance(value, int | float) and not isinstance(value, bool):
+        return float(value)
+    elif hint is bool and isinstance(value, bool):
         return value
-    raise ConfigError(f"{name} must be {ftype}, got {type(value).__name__} {value!r}")
+    elif hint in (int, str) and isinstance(value, hint) and not isinstance(value, bool):
+        return value
+    raise ConfigError(f"{name} must be {spelled}, got {type(value).__name__} {value!r}")
 
 
 def _apply(obj: Any, data: dict[str, Any], prefix: str) -> Any:
@@ -337,7 +368,8 @@ def _apply(obj: Any, data: dict[str, Any], prefix: str) -> Any:
                 raise ConfigError(f"{name} must be a table, got {value!r}")
             changes[key] = _apply(getattr(obj, key), value, f"{key}.")
         else:
-            changes[key] = _coerce(name, known[key].type, value)
+            hint = _hints(type(obj))[key]
+            changes[key] = _coerce(name, hint, value, str(known[key].type))
     return replace(obj, **changes)
 
 
@@ -503,13 +535,43 @@ def to_dict(config: RunConfig) -> dict[str, Any]:
     )
 
 
+#: TOML's short escapes in a basic string; other control characters become \uXXXX.
+_TOML_ESCAPES = {
+    '"': '\\"',
+    "\\": "\\\\",
+    "\b": "\\b",
+    "\t": "\\t",
+    "\n": "\\n",
+    "\f": "\\f",
+    "\r": "\\r",
+}
+
+
+def _toml_string(text: str) -> str:
+    """``text`` as a TOML basic string, quotes, backslashes and control characters escaped.
+
+    TOML 1.0 allows none of U+0000..U+001F (tab aside) nor U+007F unescaped in a basic
+    string: a raw newline in a reference's source made a ``config.toml`` that ``tomllib``
+    refuses, so the run trained but could not be resumed or reported.
+    """
+    out = []
+    for ch in text:
+        if ch in _TOML_ESCAPES:
+            out.append(_TOML_ESCAPES[ch])
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
 def _toml_value(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, int | float):
         return repr(value)
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return _toml_string(value)
     return "[" + ", ".join(_toml_value(v) for v in value) + "]"
 
 

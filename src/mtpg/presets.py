@@ -7,6 +7,10 @@ from __future__ import annotations
 
 from typing import Any
 
+#: Names of the evaluation backends (``backend``): this machine's threads or a Dask
+#: cluster.
+BACKENDS = ("local", "dask")
+
 #: Ways of drawing parent 1 from a subset's elites (``team.parent_selection``).
 PARENT_SELECTIONS = ("uniform", "lexicase")
 

@@ -32,11 +32,12 @@ def six_task_runs(tmp_path_factory):
 def drawn(monkeypatch):
     """The figures drawn, kept open instead of written."""
     import matplotlib.figure
-    import matplotlib.pyplot as plt
+
+    from mtpg.analysis import plotting
 
     figs = []
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda *a, **k: None)
-    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig) if fig else None)
+    monkeypatch.setattr(plotting._AggFigures, "close", lambda _self, fig: figs.append(fig))
     return figs
 
 

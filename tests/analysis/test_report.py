@@ -192,10 +192,11 @@ FIGURES = [
 def test_every_figure_is_labelled_and_states_its_numbers(runs, tmp_path, monkeypatch, draw):
     figs = []
     import matplotlib.figure
-    import matplotlib.pyplot as plt
+
+    from mtpg.analysis import plotting
 
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda *a, **k: None)  # fast
-    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig) if fig else None)
+    monkeypatch.setattr(plotting._AggFigures, "close", lambda _self, fig: figs.append(fig))
     loaded = [load_run(p) for p in runs]
     groups, _ = group_runs(loaded)
     numbers = {r.path: run_numbers(r) for r in loaded}

@@ -85,11 +85,12 @@ def runs(tmp_path_factory):
 
 def test_training_curves_draw_the_columns_of_metrics_csv(runs, tmp_path, monkeypatch):
     import matplotlib.figure
-    import matplotlib.pyplot as plt
+
+    from mtpg.analysis import plotting
 
     figs = []
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda *a, **k: None)
-    monkeypatch.setattr(plt, "close", lambda fig=None: figs.append(fig) if fig else None)
+    monkeypatch.setattr(plotting._AggFigures, "close", lambda _self, fig: figs.append(fig))
     loaded = [load_run(p) for p in runs]
     groups, _ = group_runs(loaded)
     training_curves(groups, tmp_path / "t.png")

@@ -103,3 +103,38 @@ def test_experiment_progress_reads_each_runs_metrics(tmp_path):
 
 def test_durations():
     assert [fmt_duration(s) for s in (5, 187, 7500)] == ["5s", "3m07s", "2h05m"]
+
+
+def test_a_live_line_fits_the_terminal_width(monkeypatch):
+    """Wider than the terminal, a live line would wrap and leave fragments behind."""
+    import io
+    import os
+    import shutil
+
+    from mtpg.cli.progress import Progress
+
+    tasks = (
+        "CartPole",
+        "Acrobot",
+        "CartCentering",
+        "Pendulum",
+        "MountainCar",
+        "MountainCarContinuous",
+    )
+    row = {"generation": 3, "t_total": 1.0, "decisions_per_s": 1.5e6, "teams_per_decision": 1.9}
+    row.update({f"best_{t}": -123.456 for t in tasks})
+    for columns in (80, 40):
+        size = os.terminal_size((columns, 24))
+        monkeypatch.setattr(shutil, "get_terminal_size", lambda *_a, s=size: s)
+        live = io.StringIO()
+        progress = Progress(10, tasks, stream=live, live=True)
+        progress.begin(0)
+        progress(row)
+        lines = live.getvalue().split("\r\x1b[2K")[1:]
+        assert len(lines) == 2
+        assert all(len(text) <= columns - 1 for text in lines)
+        assert lines[-1].startswith("gen 3/10 |") and lines[-1].endswith("...")
+    logged = io.StringIO()
+    progress = Progress(10, tasks, stream=logged, live=False)
+    progress(row)
+    assert "teams/dec 1.90" in logged.getvalue()  # a log keeps the whole line

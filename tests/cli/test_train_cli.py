@@ -179,7 +179,7 @@ def test_a_lost_backend_commits_the_generation_and_resume_finishes_the_run(
     assert main(["train", *TINY, "--generations", "4", "--out", str(reference)]) == 0
     # lost while generation 2 was evaluated
     lost = losing_backend(2, "lost the dask cluster at tcp://127.0.0.1:1 (gone)")
-    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg: lost(1))
+    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg, wait=None: lost(1))
     out = tmp_path / "run"
     capsys.readouterr()
     assert main(["train", *TINY, "--generations", "4", "--out", str(out)]) == 1

@@ -38,7 +38,7 @@ def test_dask_backend_without_its_packages_is_one_clear_error(monkeypatch):
 
 
 def test_train_options_become_settings():
-    from mtpg.cli.cmd_train import overrides
+    from mtpg.cli.common import overrides
     from mtpg.cli.main import build_parser
 
     args = build_parser().parse_args(

@@ -150,7 +150,7 @@ def test_a_run_failing_after_the_lock_releases_it_and_closes_its_backend(
     def failing_trainer(*args) -> None:
         raise RuntimeError("no trainer")
 
-    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg: Backend(1))
+    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg, wait=None: Backend(1))
     monkeypatch.setattr(session_module, "Trainer", failing_trainer)
     run = tmp_path / "run"
     with pytest.raises(RuntimeError, match="no trainer"):
@@ -181,7 +181,9 @@ def test_a_lost_backend_commits_the_generation_it_was_lost_in(tmp_path, monkeypa
     from mtpg.engine.evaluator import BackendLost
     from standins import losing_backend
 
-    monkeypatch.setattr(session_module, "make_evaluator", lambda cfg: losing_backend(2)(1))
+    monkeypatch.setattr(
+        session_module, "make_evaluator", lambda cfg, wait=None: losing_backend(2)(1)
+    )
     run = tmp_path / "run"
     session = Session(run, tiny("checkpoint_interval=10", "generations=4"))
     with pytest.raises(BackendLost, match="gone"):

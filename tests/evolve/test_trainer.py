@@ -84,7 +84,7 @@ def test_resumed_run_equals_uninterrupted(tmp_path):
     ],
 )
 def test_ablation_switches_change_exactly_what_they_name(switch, field, value):
-    from mtpg.cli.cmd_train import overrides
+    from mtpg.cli.common import overrides
     from mtpg.cli.main import build_parser
     from mtpg.config import to_dict
 

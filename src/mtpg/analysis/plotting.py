@@ -1,4 +1,4 @@
-"""Shared matplotlib helpers of every figure: the file-only backend, captions and saving."""
+"""Shared matplotlib helpers of every figure: file-only figures, captions and saving."""
 
 from __future__ import annotations
 
@@ -9,14 +9,40 @@ from pathlib import Path
 DPI = 110
 
 
-def pyplot():
-    """The pyplot module of matplotlib on the file-only Agg backend."""
-    import matplotlib
+class _AggFigures:
+    """The part of pyplot the figures use, on figures pyplot never sees.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Each figure gets its own Agg canvas (files only, no window), so drawing a report
+    neither needs a display nor switches the backend of the caller's session (a notebook's
+    inline figures, say), as ``matplotlib.use("Agg")`` did.
+    """
 
-    return plt
+    def __init__(self) -> None:
+        import matplotlib
+
+        self.rcParams = matplotlib.rcParams
+        self._colormaps = matplotlib.colormaps
+
+    def subplots(self, nrows: int = 1, ncols: int = 1, *, figsize=None, **kwargs):
+        """A new figure and its axes, as ``pyplot.subplots`` returns them."""
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=figsize)
+        FigureCanvasAgg(fig)
+        return fig, fig.subplots(nrows, ncols, **kwargs)
+
+    def get_cmap(self, name: str):
+        """The named colormap."""
+        return self._colormaps[name]
+
+    def close(self, fig) -> None:
+        """Nothing to release: pyplot holds no reference to these figures."""
+
+
+def pyplot() -> _AggFigures:
+    """What the figures need of pyplot, on their own Agg canvases (:class:`_AggFigures`)."""
+    return _AggFigures()
 
 
 def save(fig, path: Path) -> Path:

@@ -38,8 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.graph.page import build_analysis
-    from mtpg.cli.cmd_evaluate import resolve_graph
-    from mtpg.cli.cmd_train import task_list
+    from mtpg.cli.common import resolve_graph, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
     from mtpg.envs.core import TASK_NAMES

@@ -6,6 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
+from mtpg.cli.common import resolve_graph
 from mtpg.cli.memory_option import add_memory_option, resolve_no_memory
 
 
@@ -34,38 +35,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def resolve_graph(target: Path):
-    """Loads the graph a path names: a graph file, or a run's reported champion.
-
-    For a run directory this is the champion the report shows
-    (:func:`mtpg.analysis.runs.champions.run_champion`).
-
-    Returns:
-        ``(population, root, meta, default task names)``.
-    """
-    from mtpg.io.serialize import load_graph
-
-    if not target.exists():
-        raise FileNotFoundError(f"{target}: no such graph file or run directory")
-    if target.is_dir():
-        from mtpg.analysis.runs.champions import run_champion
-        from mtpg.io.runconfig import read_run_config
-
-        config = read_run_config(target)
-        pop, root, meta = load_graph(run_champion(target))
-        meta.setdefault("no_memory", config.evaluation.no_memory)  # the run's ablation
-        meta.setdefault("test_episodes", config.evaluation.test_episodes)
-        return pop, root, meta, list(config.evaluation.tasks)
-    pop, root, meta = load_graph(target)
-    from mtpg.envs.registry import PAPER_TASKS
-
-    return pop, root, meta, list(meta.get("tasks", PAPER_TASKS))
-
-
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.runs.loading import normalise_scores
-    from mtpg.cli.cmd_train import task_list
+    from mtpg.cli.common import task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.protocol import N_TEST_EPISODES

@@ -7,7 +7,7 @@ import argparse
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Adds the ``experiment`` command."""
-    from mtpg.cli.cmd_train import preset_help
+    from mtpg.cli.common import preset_help
 
     p = subparsers.add_parser(
         "experiment",
@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
     from pathlib import Path
 
-    from mtpg.cli.cmd_train import overrides
+    from mtpg.cli.common import overrides
     from mtpg.cli.main import UsageError, build_parser
     from mtpg.cli.progress import ExperimentProgress
     from mtpg.config import build_config

@@ -90,7 +90,7 @@ def choose_memory(choice: str, meta: dict, path: Path) -> tuple[bool, str]:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.cli.cmd_train import task_list
+    from mtpg.cli.common import task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.registry import PAPER_TASKS

@@ -40,8 +40,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from mtpg.analysis.graph.replay import replay_task
-    from mtpg.cli.cmd_evaluate import resolve_graph
-    from mtpg.cli.cmd_train import task_list
+    from mtpg.cli.common import resolve_graph, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
     from mtpg.envs.core import TASK_NAMES

@@ -25,7 +25,7 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.description.layout import render_svg
     from mtpg.analysis.description.listing import describe_graph, graph_dot
-    from mtpg.cli.cmd_evaluate import resolve_graph
+    from mtpg.cli.common import resolve_graph
 
     target = Path(args.target)
     pop, root, meta, _ = resolve_graph(target)

@@ -6,17 +6,8 @@ import argparse
 import sys
 
 from mtpg.ablations import ABLATION_TABLE
-from mtpg.presets import PRESETS
-
-
-def preset_help() -> str:
-    """The help of ``--preset``: every preset by name, as :data:`mtpg.presets.PRESETS` has them."""
-    names = list(PRESETS)
-    listed = ", ".join(names[:-1]) + " or " + names[-1]
-    return (
-        f"configuration preset: {listed} (robust = paper with the training episodes redrawn "
-        "every 10 generations; default: demo)"
-    )
+from mtpg.cli.common import overrides, preset_help
+from mtpg.presets import BACKENDS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -44,7 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--backend",
-        choices=("local", "dask"),
+        choices=BACKENDS,
         help="evaluate on this machine's threads (local) or a Dask cluster (dask)",
     )
     p.add_argument("--address", metavar="TCP://HOST:PORT", help="scheduler of a Dask cluster")
@@ -85,49 +76,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def task_list(text: str, option: str = "--tasks") -> list[str]:
-    """The canonical names of a comma-separated list option, refusing an empty one.
-
-    Commas inside a variant's brackets do not split (``CartPole[max_steps=500],Pendulum``);
-    each name is checked and spelled canonically (``mtpg.envs.variants.canonical``).
-    """
-    from mtpg.cli.main import UsageError
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.variants import canonical, is_variant
-
-    parts, depth, word = [], 0, ""
-    for ch in text:
-        depth += {"[": 1, "]": -1}.get(ch, 0)
-        if ch == "," and depth <= 0:
-            parts.append(word)
-            word = ""
-        else:
-            word += ch
-    names = [t.strip() for t in [*parts, word] if t.strip()]
-    if not names:
-        raise UsageError(f"{option}: empty list; name at least one of {', '.join(TASK_NAMES)}")
-    try:  # a plain unknown name is left to the configuration's check, which names the field
-        return [canonical(t) if is_variant(t) else t for t in names]
-    except ValueError as exc:
-        raise UsageError(f"{option}: {exc}") from None
-
-
-def overrides(args: argparse.Namespace) -> list[str]:
-    """The ``section.field=value`` overrides the options stand for."""
-    out = list(args.set)
-    if args.tasks is not None:
-        names = task_list(args.tasks)
-        out.append("evaluation.tasks=[" + ", ".join(f'"{t}"' for t in names) + "]")
-    for key in ("generations", "seed", "workers", "dask_workers"):
-        if getattr(args, key) is not None:
-            out.append(f"{key}={getattr(args, key)}")
-    for key in ("backend", "address"):
-        if getattr(args, key) is not None:
-            out.append(f'{key}="{getattr(args, key)}"')
-    out += [abl.override for abl in ABLATION_TABLE if getattr(args, abl.dest)]
-    return out
-
-
 def _fresh_dir(base: str) -> str:
     """``base``, or ``base-2``, ``base-3``, ... when taken (the default run directory)."""
     from pathlib import Path
@@ -140,27 +88,14 @@ def _fresh_dir(base: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Runs the command, with ``--scheduler-wait`` in force (and put back) around it."""
-    import os
-
+    """Runs the command; ``--scheduler-wait`` is checked here and given to the run's session."""
     from mtpg.cli.main import UsageError
-    from mtpg.engine.dask_backend import SCHEDULER_WAIT_ENV
 
-    if args.scheduler_wait is None:
-        return _train(args)
-    if not 0 < args.scheduler_wait <= 3600:
+    if args.scheduler_wait is not None and not 0 < args.scheduler_wait <= 3600:
         raise UsageError(
             f"--scheduler-wait must be in (0, 3600] seconds, got {args.scheduler_wait}"
         )
-    old = os.environ.get(SCHEDULER_WAIT_ENV)
-    os.environ[SCHEDULER_WAIT_ENV] = repr(args.scheduler_wait)
-    try:
-        return _train(args)
-    finally:
-        if old is None:
-            del os.environ[SCHEDULER_WAIT_ENV]
-        else:
-            os.environ[SCHEDULER_WAIT_ENV] = old
+    return _train(args)
 
 
 def _train(args: argparse.Namespace) -> int:
@@ -186,11 +121,11 @@ def _train(args: argparse.Namespace) -> int:
     with GracefulStop("mtpg train", "the generation under way is committed") as stop:
         if args.resume:
             config = merge_overrides(read_run_config(args.resume, resuming=True), overrides(args))
-            session = Session(args.resume, config, resume=True)
+            session = Session(args.resume, config, resume=True, scheduler_wait=args.scheduler_wait)
         else:
             config = build_config(args.preset, args.config, overrides(args))
             out = args.out or _fresh_dir(f"runs/{args.preset}-seed{config.seed}")
-            session = Session(out, config)
+            session = Session(out, config, scheduler_wait=args.scheduler_wait)
         cfg, where = session.config, session.run.path
         print(
             f"run directory: {where}  (generation {session.trainer.state.generation}"

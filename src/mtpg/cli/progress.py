@@ -15,6 +15,7 @@ point G: the number the report shows.
 from __future__ import annotations
 
 import csv
+import shutil
 import sys
 import threading
 import time
@@ -168,9 +169,20 @@ class Progress:
             f"gen {generation + 1}/{self.total}: compiling the engine's kernels (cached after "
             "the first run), then evaluating..."
         )
-        self.stream.write(("\r\x1b[2K" + text) if self.live else text + "\n")
+        self.stream.write(("\r\x1b[2K" + self._fit(text)) if self.live else text + "\n")
         self.stream.flush()
         self._last = time.perf_counter()
+
+    def _fit(self, text: str) -> str:
+        """A live line cut to the terminal's width (read at each write: it may change).
+
+        Clearing the line clears only the row the cursor is on: a line longer than the
+        terminal would wrap, and each update would leave its first rows behind.
+        """
+        width = shutil.get_terminal_size((80, 24)).columns - 1  # no wrap at the last column
+        if len(text) <= width:
+            return text
+        return text[: max(width - 3, 0)] + "..."
 
     def eta(self, generation: int) -> float:
         """Seconds left: mean duration of the recent generations times those remaining.
@@ -212,7 +224,7 @@ class Progress:
             self.test = last_test(self.tests_file, "+".join(self.tasks)) or self.test
         text = self.line(row)
         if self.live:
-            self.stream.write("\r\x1b[2K" + text)
+            self.stream.write("\r\x1b[2K" + self._fit(text))
             if row["generation"] >= self.total:
                 self.stream.write("\n")
         else:

@@ -105,11 +105,6 @@ class CompiledPopulation:
         """Workspace index of the first memory register."""
         return self.graph.mem_base
 
-    @property
-    def workspace_size(self) -> int:
-        """Length of a workspace holding every bank."""
-        return self.mem_base + len(self.bank_ids) * self.layout.n_memory
-
     def team_index(self, team_id: int) -> int:
         """Dense index of a model team id."""
         return int(np.searchsorted(self.team_ids, team_id))
@@ -160,28 +155,6 @@ def effective_mask(instructions: np.ndarray, layout: RegisterLayout) -> np.ndarr
         Boolean array of length ``n``; False marks an intron.
     """
     return _effective_kernel(np.ascontiguousarray(instructions, dtype=np.int32), layout.n_registers)
-
-
-def workspace_map(layout: RegisterLayout, bank: int, mem_base: int) -> np.ndarray:
-    """Maps logical register indices of a program with dense ``bank`` to workspace indices.
-
-    Args:
-        layout: Register sizes.
-        bank: Dense memory bank index of the program.
-        mem_base: Workspace index of bank 0.
-
-    Returns:
-        int32 array of length ``layout.size``.
-    """
-    r, m = layout.n_registers, layout.n_memory
-    return np.concatenate(
-        [
-            np.arange(r),
-            mem_base + bank * m + np.arange(m),
-            r + np.arange(N_CONSTANTS),
-            r + N_CONSTANTS + np.arange(layout.n_obs),
-        ]
-    ).astype(np.int32)
 
 
 def effective_code(prog: Program, layout: RegisterLayout) -> np.ndarray:

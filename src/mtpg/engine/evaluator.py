@@ -27,9 +27,6 @@ import numpy as np
 from mtpg.engine.batch import BatchResult, Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation
 
-#: Names of the evaluation backends (``backend``).
-BACKENDS = ("local", "dask")
-
 
 class BackendLost(RuntimeError):
     """The evaluation backend went away; the run stops at a generation boundary."""

@@ -13,12 +13,15 @@ from mtpg.config import ConfigError, RunConfig
 from mtpg.engine.evaluator import BackendError, Evaluator, LocalEvaluator
 
 
-def make_evaluator(config: RunConfig) -> Evaluator:
+def make_evaluator(config: RunConfig, scheduler_wait: float | None = None) -> Evaluator:
     """The evaluator a run configuration asks for.
 
     Args:
         config: The run configuration (``backend``, ``address``, ``dask_workers``,
             ``workers``).
+        scheduler_wait: Seconds a Dask evaluator waits for its scheduler (``mtpg train
+            --scheduler-wait``; not part of the run); None: ``$MTPG_SCHEDULER_WAIT`` or the
+            default (:func:`mtpg.engine.dask_backend.scheduler_wait`).
 
     Returns:
         A :class:`~mtpg.engine.evaluator.LocalEvaluator` or a connected
@@ -51,6 +54,7 @@ def make_evaluator(config: RunConfig) -> Evaluator:
             address=config.address or None,
             n_workers=config.dask_workers,
             fallback_threads=config.workers,
+            timeout=scheduler_wait,
         )
     except BackendError as exc:
         raise ConfigError(str(exc)) from exc

@@ -114,18 +114,15 @@ def execute(
                 run = todo.pop(0)
                 log(f"{run.path.name}: {run.state(generations)} -> starting")
                 run.path.parent.mkdir(parents=True, exist_ok=True)
-                logfile = open(run.path.parent / f"{run.path.name}.log", "a")
-                running.append(
-                    (
-                        run,
-                        subprocess.Popen(
-                            run.command(train_args, generations, workers),
-                            stdout=logfile,
-                            stderr=subprocess.STDOUT,
-                            start_new_session=True,  # signals reach it once, passed on by us
-                        ),
+                # the child holds its own copy of the log's descriptor: ours closes at once
+                with open(run.path.parent / f"{run.path.name}.log", "a") as logfile:
+                    proc = subprocess.Popen(
+                        run.command(train_args, generations, workers),
+                        stdout=logfile,
+                        stderr=subprocess.STDOUT,
+                        start_new_session=True,  # signals reach it once, passed on by us
                     )
-                )
+                running.append((run, proc))
             time.sleep(0.2)
             for item in list(running):
                 run, proc = item

@@ -123,6 +123,8 @@ class Session:
         config: Configuration of a new run; for a resumed run, None or a configuration
             that differs from the stored one only in :data:`RESUMABLE_CHANGES`.
         resume: Continue the run in ``run_dir`` from its last checkpoint.
+        scheduler_wait: Seconds the Dask backend waits for its scheduler (not stored with
+            the run); None: ``$MTPG_SCHEDULER_WAIT`` or the default.
 
     Raises:
         ConfigError, RunDirError, CheckpointError, BudgetError: Bad input; nothing
@@ -131,7 +133,11 @@ class Session:
     """
 
     def __init__(
-        self, run_dir: str | Path, config: RunConfig | None = None, resume: bool = False
+        self,
+        run_dir: str | Path,
+        config: RunConfig | None = None,
+        resume: bool = False,
+        scheduler_wait: float | None = None,
     ) -> None:
         path = Path(run_dir)
         if resume:
@@ -149,7 +155,8 @@ class Session:
         check_stop_at()  # a bad MTPG_TEST_STOP_AT (fault-injection points) is refused here
         ckpt = latest_checkpoint(path) if resume else None
         state = load_state(path, config, ckpt) if ckpt else None
-        evaluator = make_evaluator(config)  # an unreachable scheduler stops the run here
+        # an unreachable scheduler stops the run here
+        evaluator = make_evaluator(config, scheduler_wait)
         # -- first write --------------------------------------------------------------
         self.lock: DirLock | None = None
         self.metrics: MetricsReporter | None = None

@@ -1,7 +1,8 @@
 """The generational loop (paper section 4.1): vary, evaluate new roots, select, delete.
 
-The trainer owns the run state and does no I/O; the CLI writes metrics, checkpoints and
-champions from what :meth:`Trainer.run_generation` returns.
+The trainer owns the run state and does no I/O: the loop over generations and the
+reporters that write metrics, tests, checkpoints and champions from what
+:meth:`Trainer.run_generation` returns are in :mod:`mtpg.evolve.reporters`.
 """
 
 from __future__ import annotations

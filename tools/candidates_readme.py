@@ -77,7 +77,7 @@ def main() -> int:
     """Scores the finished runs and rewrites the README's table; returns the exit status."""
     results: dict[str, dict[str, dict[str, float]]] = {}
     for group, prefix in GROUPS.items():
-        runs = sorted((FOLDER / "runs").glob(f"{prefix}[0-9]*"))
+        runs = sorted(p for p in (FOLDER / "runs").glob(f"{prefix}[0-9]*") if p.is_dir())
         results[group] = {r.name: scores(r) for r in runs if finished(r)}
         print(f"{group}: {len(results[group])} of {len(runs)} runs finished", flush=True)
     if not any(results.values()):

@@ -6,8 +6,10 @@ compiled graph (:class:`~mtpg.engine.compile.Graph`), the jobs and the episode t
 (:class:`~mtpg.engine.batch.BatchResult`) and one thread's private :class:`Buffers`, whose
 float64 workspace ``W`` is laid out as documented in :mod:`mtpg.engine.compile`.
 
-The decision semantics live in :func:`decide` alone and the episode loop in
-:func:`run_jobs_queue` alone: the tracer (:mod:`mtpg.engine.trace`) runs the same two with
+The scalar decision semantics live in :func:`decide` alone and the scalar episode loop
+in :func:`run_jobs_queue` alone (the lane engine, :mod:`mtpg.engine.lanes`, plays many
+episodes at once and is tested to match them job by job): the tracer
+(:mod:`mtpg.engine.trace`) runs the same two with
 a :class:`~mtpg.engine.record.Recorder`, and the training path passes ``rec=None``, with
 which Numba compiles every recording branch out.
 

@@ -11,17 +11,17 @@ lanes split into the groups of the teams they move to. When every lane has reach
 atomic action, each lane's task takes one step; a lane whose episode ends leaves.
 
 Each lane computes exactly the operations the scalar kernel computes, in the same order,
-with the same compiled :func:`~mtpg.engine.ops.apply_op` (no vector math library: a lane's
-``cos`` is the same scalar call), so every job's return, steps, teams visited and
+with the same operation functions (:mod:`mtpg.engine.lane_ops`; no vector math library:
+a lane's ``cos`` is the same scalar call), so every job's return, steps, teams visited and
 instructions executed are bit for bit those of :func:`~mtpg.engine.kernels.run_jobs_queue`
 (tested), whatever the lane-block size, the order of the jobs or the threads.
 
-Layout: the workspace is a float64 ``[n_addresses, lanes]`` array: the address of every
-operand is the scalar workspace's (:mod:`mtpg.engine.compile`) and a lane its column, so
-the lanes of one register are adjacent. All lanes of a block start their episodes
-together, so a bank is reset lazily for all lanes at once (its stamp is the block's),
-which equals resetting it at each lane's episode start; visited teams are stamped per lane
-with the step's mark.
+Layout: each lane block plays its own compact copy of its graph
+(:mod:`mtpg.engine.lane_graph`), whose workspace has a row per register, observation input
+and bank register and a column per lane, so the lanes of one register are adjacent. All
+lanes of a block start their episodes together, so a bank is zeroed for all lanes at its
+first use in the block, which equals resetting it at each lane's episode start; visited
+teams are stamped per lane with the step's mark.
 """
 
 from __future__ import annotations

@@ -25,7 +25,14 @@ from gymnasium import spaces
 from mtpg.envs.core import N_OBS, STATE_SIZE, STEP_SLOT
 from mtpg.envs.episodes import sample_start
 from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.variants import obs_noise_sd, resolve, spec_of, task_params, valid_id
+from mtpg.envs.variants import (
+    obs_noise_sd,
+    observation_bounds,
+    resolve,
+    spec_of,
+    task_params,
+    valid_id,
+)
 
 #: The action interfaces: the paper's pair, or the task's own single action.
 ACTIONS: tuple[str, ...] = ("paper", "native")
@@ -89,7 +96,8 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         self._task = int(task)
         self._native = action == "native"
         self.render_mode = render_mode
-        self.observation_space = spaces.Box(-1.0, 1.0, (N_OBS,), dtype=np.float64)
+        low, high = observation_bounds(self._task)
+        self.observation_space = spaces.Box(low, high, (N_OBS,), dtype=np.float64)
         self.action_space = (
             native_action_space(self._task) if self._native else paper_action_space()
         )

@@ -44,16 +44,23 @@ from mtpg.envs.core import (
     STEP_SLOT,
 )
 from mtpg.envs.tasks import (
+    OBS_COS,
+    OBS_SIN,
+    OBS_WRAP,
     P_FORCE,
     P_KIND,
     P_MAX_STEPS,
+    P_NOISE_HI,
+    P_NOISE_LO,
     P_OBS,
+    P_OBS_FN,
     P_OBS_HI,
     P_OBS_LO,
     P_OBS_NOISY,
+    P_OBS_OUT_HI,
+    P_OBS_OUT_LO,
     P_OBS_SD,
     P_OBS_SLOT,
-    P_OBS_WRAP,
 )
 
 #: Options of the step and observation dispatch, which take arrays and allocate none:
@@ -143,24 +150,57 @@ def observe_kind(p: np.ndarray) -> int:
 
 @step_kernel
 def variant_observe(p: np.ndarray, state: np.ndarray, noise: float, obs: np.ndarray) -> None:
-    """A variant's observation: each input a state slot scaled to [-1, 1], or the noise.
+    """A variant's observation: each input a state slot scaled to a range, or the noise.
+
+    A state input takes its slot's value (wrapped, or its cosine or sine, by ``P_OBS_FN``)
+    and maps ``P_OBS_LO..P_OBS_HI`` linearly onto ``P_OBS_OUT_LO..P_OBS_OUT_HI`` (-1..1
+    unless the variant sets ``obs_low`` / ``obs_high``), clipped to that range (a NaN
+    becomes its middle). When the two ranges are the same the value is taken as it is.
+    The noise input is the U[0, 1] draw, or ``P_NOISE_LO + (P_NOISE_HI - P_NOISE_LO) *
+    draw`` unclipped when the variant sets ``noise_low`` / ``noise_high`` (the authors'
+    code feeds U[-pi, pi] noise as it is).
 
     Args:
-        p: The variant's parameter row (columns ``P_OBS_*``).
+        p: The variant's parameter row (columns ``P_OBS_*``, ``P_NOISE_*``).
         state: The current state array.
         noise: The episode's U[0, 1] noise value for this step.
         obs: Output array of at least two slots.
     """
+    out_lo = p[P_OBS_OUT_LO]
+    out_hi = p[P_OBS_OUT_HI]
+    default_out = out_lo == -1.0 and out_hi == 1.0
     for i in range(2):
         slot = np.int64(p[P_OBS_SLOT + i])
         if slot < 0:
-            obs[i] = clip_obs(noise)
+            n_lo = p[P_NOISE_LO]
+            n_hi = p[P_NOISE_HI]
+            if n_lo == 0.0 and n_hi == 1.0:
+                obs[i] = clip_obs(noise)
+            else:
+                obs[i] = n_lo + (n_hi - n_lo) * noise
+            continue
+        x = state[slot]
+        fn = np.int64(p[P_OBS_FN + i])
+        if fn == OBS_WRAP:
+            x = pendulum.angle_normalize(x)
+        elif fn == OBS_COS:
+            x = np.cos(x)
+        elif fn == OBS_SIN:
+            x = np.sin(x)
+        lo = p[P_OBS_LO + i]
+        hi = p[P_OBS_HI + i]
+        if lo == out_lo and hi == out_hi:
+            v = x
+        elif default_out:
+            v = 2.0 * (x - lo) / (hi - lo) - 1.0
         else:
-            x = state[slot]
-            if p[P_OBS_WRAP + i] != 0.0:
-                x = pendulum.angle_normalize(x)
-            lo = p[P_OBS_LO + i]
-            obs[i] = clip_obs(2.0 * (x - lo) / (p[P_OBS_HI + i] - lo) - 1.0)
+            v = out_lo + (out_hi - out_lo) * (x - lo) / (hi - lo)
+        if default_out:
+            obs[i] = clip_obs(v)
+        elif v != v:
+            obs[i] = 0.5 * (out_lo + out_hi)
+        else:
+            obs[i] = min(max(v, out_lo), out_hi)
 
 
 @step_kernel

@@ -41,8 +41,9 @@ P_OBS_SLOT = N_TASK_COLUMNS + 2
 P_OBS_LO = N_TASK_COLUMNS + 4
 #: Two columns: the value each observed slot maps to +1.
 P_OBS_HI = N_TASK_COLUMNS + 6
-#: Two columns: 1 when the observed slot is an angle wrapped into [-pi, pi) first.
-P_OBS_WRAP = N_TASK_COLUMNS + 8
+#: Two columns: what is taken of the observed slot before scaling (``OBS_AS_IS``,
+#: ``OBS_WRAP``, ``OBS_COS`` or ``OBS_SIN``).
+P_OBS_FN = N_TASK_COLUMNS + 8
 
 #: The standard deviation of the Gaussian observation noise added to the inputs that
 #: observe the state (0: none), in the inputs' [-1, 1] units.
@@ -50,8 +51,21 @@ P_OBS_SD = N_TASK_COLUMNS + 10
 #: How many leading inputs observe the state (the others are the U[0, 1] noise input).
 P_OBS_NOISY = N_TASK_COLUMNS + 11
 
+#: The value an observed slot's ``P_OBS_LO`` maps to (-1 unless a variant's ``obs_low``).
+P_OBS_OUT_LO = N_TASK_COLUMNS + 12
+#: The value an observed slot's ``P_OBS_HI`` maps to (+1 unless a variant's ``obs_high``).
+P_OBS_OUT_HI = N_TASK_COLUMNS + 13
+#: The value the U[0, 1] noise draw 0 maps to (0 unless a variant's ``noise_low``).
+P_NOISE_LO = N_TASK_COLUMNS + 14
+#: The value the U[0, 1] noise draw 1 maps to (1 unless a variant's ``noise_high``).
+P_NOISE_HI = N_TASK_COLUMNS + 15
+
 #: Number of columns of ``TASK_PARAMS``.
-N_PARAMS = N_TASK_COLUMNS + 12
+N_PARAMS = N_TASK_COLUMNS + 16
+
+#: ``P_OBS_FN`` codes: the slot's value as it is, wrapped into [-pi, pi), or its cosine or
+#: sine (an angle observed as ``cos(theta)`` / ``sin(theta)``).
+OBS_AS_IS, OBS_WRAP, OBS_COS, OBS_SIN = 0, 1, 2, 3
 #: Number of tasks.
 N_TASKS = len(TASKS)
 
@@ -59,9 +73,11 @@ N_TASKS = len(TASKS)
 def param_row(
     params: tuple[float, ...],
     kind: int,
-    observe: tuple[tuple[int, float, float, bool], ...] | None = None,
+    observe: tuple[tuple[int, float, float, int], ...] | None = None,
     obs_sd: float = 0.0,
     noisy_inputs: int = 0,
+    out_range: tuple[float, float] = (-1.0, 1.0),
+    noise_range: tuple[float, float] = (0.0, 1.0),
 ) -> np.ndarray:
     """One row of the parameter table: the task's columns, then the interface columns.
 
@@ -69,9 +85,12 @@ def param_row(
         params: The task's parameter row.
         kind: The id of the task whose kernels play the row.
         observe: None for the task's own observation, else up to two
-            ``(slot, low, high, wrap)`` inputs (a missing second input is noise).
+            ``(slot, low, high, fn)`` inputs (a missing second input is noise; ``fn`` a
+            ``P_OBS_FN`` code).
         obs_sd: Standard deviation of the Gaussian observation noise (0: none).
         noisy_inputs: How many leading inputs observe the state (and get that noise).
+        out_range: The values an observed slot's ``low`` and ``high`` map to.
+        noise_range: The values the U[0, 1] noise draws 0 and 1 map to.
 
     Returns:
         float64 ``[N_PARAMS]``; unused task columns are 0.
@@ -82,13 +101,15 @@ def param_row(
     if observe is not None:
         row[P_OBS] = 1.0
         row[P_OBS_SLOT : P_OBS_SLOT + 2] = -1.0
-        for i, (slot, lo, hi, wrap) in enumerate(observe):
+        for i, (slot, lo, hi, fn) in enumerate(observe):
             row[P_OBS_SLOT + i] = slot
             row[P_OBS_LO + i] = lo
             row[P_OBS_HI + i] = hi
-            row[P_OBS_WRAP + i] = float(wrap)
+            row[P_OBS_FN + i] = fn
     row[P_OBS_SD] = obs_sd
     row[P_OBS_NOISY] = noisy_inputs
+    row[P_OBS_OUT_LO], row[P_OBS_OUT_HI] = out_range
+    row[P_NOISE_LO], row[P_NOISE_HI] = noise_range
     return row
 
 

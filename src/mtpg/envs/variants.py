@@ -8,7 +8,17 @@ A variant is a registered task with some of its settings changed, written
 - ``observe``: the one or two state variables the two inputs observe, joined by ``+``
   (``observe=x+theta``), each scaled from the base spec's ``state_low..state_high`` to
   [-1, 1] (angles wrapped into [-pi, pi) first) and clipped; with one variable the second
-  input is the U[0, 1] noise input, as in the paper's one-observable tasks;
+  input is the U[0, 1] noise input, as in the paper's one-observable tasks. An angle may
+  be observed as its cosine or sine, ``cos(theta)`` / ``sin(theta)`` (range -1..1), as
+  the authors' code observes the pendulum;
+- ``obs_low`` / ``obs_high``: the range the observed state inputs are scaled to instead
+  of [-1, 1] (the authors' code scales MountainCar's position to [0, 1]);
+- ``noise_low`` / ``noise_high``: the noise input is ``U[noise_low, noise_high]``
+  instead of U[0, 1] (the same draw, mapped linearly; not clipped: the authors' code
+  feeds U[-pi, pi]). Only a task with a noise input takes them. These four keys, like
+  ``observe``, make the variant observe through :func:`mtpg.envs.kernels.variant_observe`
+  (the base's own observed variables when ``observe`` is not given); numbers may be
+  written ``pi`` or ``-pi``;
 - ``noise``: Gaussian observation noise: each input that observes the state gets
   ``sd * N(0, 1)`` added (in its [-1, 1] units) and is clipped again; ``sd >= 0``. The
   normal values are drawn per episode after its start state and U[0, 1] values
@@ -60,25 +70,56 @@ def _fail(text: str, message: str) -> ValueError:
     return ValueError(f"task {text!r}: {message}")
 
 
+#: The keys that change what the inputs observe (a variant with any of them observes
+#: through ``variant_observe``).
+INTERFACE_KEYS = ("noise_high", "noise_low", "obs_high", "obs_low", "observe")
+#: The default of each range key.
+_RANGE_DEFAULTS = {"obs_low": -1.0, "obs_high": 1.0, "noise_low": 0.0, "noise_high": 1.0}
+_FUNCTION = re.compile(r"^(?P<fn>cos|sin)\((?P<name>[A-Za-z_0-9]+)\)$")
+
+
 def allowed_keys(base: TaskSpec) -> tuple[str, ...]:
     """The keys a variant of ``base`` may set."""
-    return (*base.param_names, "noise", "observe")
+    return (*base.param_names, "noise", *INTERFACE_KEYS)
+
+
+def _observable(base: TaskSpec, name: str) -> bool:
+    """Whether ``name`` is a state variable of ``base``, or cos/sin of one of its angles."""
+    m = _FUNCTION.match(name)
+    if m is None:
+        return name in base.state_names
+    return m["name"] in base.state_names and base.state_names.index(m["name"]) in base.angle_slots
+
+
+def observe_column(base: TaskSpec, name: str) -> tuple[int, float, float, int]:
+    """The ``(slot, low, high, fn)`` input of one observed name (see ``param_row``)."""
+    from mtpg.envs.tasks import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP
+
+    m = _FUNCTION.match(name)
+    if m is not None:
+        fn = OBS_COS if m["fn"] == "cos" else OBS_SIN
+        return base.state_names.index(m["name"]), -1.0, 1.0, fn
+    s = base.state_names.index(name)
+    fn = OBS_WRAP if s in base.angle_slots else OBS_AS_IS
+    return s, base.state_low[s], base.state_high[s], fn
 
 
 def _value(text: str, base: TaskSpec, key: str, raw: str) -> str:
     """The canonical spelling of one value (raises naming the key and what is allowed)."""
     if key == "observe":
         names = raw.split("+")
-        bad = [n for n in names if n not in base.state_names]
+        bad = [n for n in names if not _observable(base, n)]
         if not raw or bad:
-            allowed = ", ".join(base.state_names)
+            angles = [base.state_names[a] for a in base.angle_slots]
+            functions = (f"{f}({a})" for a in angles for f in ("cos", "sin"))
+            allowed = ", ".join((*base.state_names, *functions))
             what = f"unknown state variable {bad[0]!r}" if bad and bad[0] else "empty"
             raise _fail(text, f"observe: {what}; allowed: {allowed} (one or two, joined by +)")
         if len(names) > 2 or len(set(names)) != len(names):
             raise _fail(text, "observe: one or two distinct state variables, joined by +")
         return "+".join(names)
     try:
-        number = float(raw)
+        number = {"pi": math.pi, "-pi": -math.pi}.get(raw) or float(raw)
     except ValueError:
         raise _fail(text, f"{key}: {raw!r} is not a number") from None
     if not math.isfinite(number):
@@ -120,7 +161,42 @@ def parse(text: str) -> tuple[TaskSpec, dict[str, str]]:
         settings[key] = _value(text, base, key, raw)
     if not settings:
         raise _fail(text, f"no settings; allowed keys: {', '.join(allowed_keys(base))}")
+    _check_interface(text, base, settings)
     return base, settings
+
+
+def _range(settings: dict[str, str], key: str) -> float:
+    return float(settings.get(key, _RANGE_DEFAULTS[key]))
+
+
+def _check_interface(text: str, base: TaskSpec, settings: dict[str, str]) -> None:
+    """Refuses range keys that contradict each other or the task (one line, naming them)."""
+    for low, high in (("obs_low", "obs_high"), ("noise_low", "noise_high")):
+        if (low in settings or high in settings) and _range(settings, low) >= _range(
+            settings, high
+        ):
+            raise _fail(
+                text,
+                f"{low} must be below {high} (defaults: {_RANGE_DEFAULTS[low]:g}, "
+                f"{_RANGE_DEFAULTS[high]:g})",
+            )
+    if ("noise_low" in settings or "noise_high" in settings) and len(
+        observed_names(base, settings)
+    ) == 2:
+        raise _fail(
+            text,
+            "noise_low/noise_high: the task observes two state variables and has no noise input",
+        )
+    ranged = "obs_low" in settings or "obs_high" in settings
+    if float(settings.get("noise", 0.0)) > 0.0 and ranged:
+        raise _fail(text, "noise (Gaussian, in [-1, 1] units) cannot go with obs_low/obs_high")
+
+
+def observed_names(base: TaskSpec, settings: dict[str, str]) -> list[str]:
+    """The names the inputs observe: ``observe``'s, or the base task's own variables."""
+    if "observe" in settings:
+        return settings["observe"].split("+")
+    return [base.state_names[s] for s in base.observed_slots]
 
 
 def canonical(text: str) -> str:
@@ -198,7 +274,10 @@ def gym_id(name: str) -> str:
     if not is_variant(name):
         return f"mtpg/{name}-v0"
     base, settings = parse(name)
-    parts = [f"{k}_{settings[k].replace('+', '.')}" for k in sorted(settings)]
+    parts = [
+        f"{k}_{settings[k].replace('+', '.').replace('(', '_').replace(')', '')}"
+        for k in sorted(settings)
+    ]
     return f"mtpg/{base.name}-{'-'.join(parts)}-v0"
 
 
@@ -207,7 +286,7 @@ def variant_spec(name: str) -> TaskSpec:
     base, settings = parse(name)
     params = list(base.params)
     for key, value in settings.items():
-        if key not in ("observe", "noise"):
+        if key in base.param_names:
             params[base.param_names.index(key)] = float(value)
     spec = replace(
         base,
@@ -216,10 +295,17 @@ def variant_spec(name: str) -> TaskSpec:
         reference=Reference(NONE, NONE, NONE, NONE, "not measured"),
         base=base.name,
     )
-    if "observe" in settings:
-        observed = settings["observe"].split("+")
-        slots = tuple(base.state_names.index(v) for v in observed)
-        text = ", ".join(f"{v} scaled" for v in observed) + (", noise" if len(slots) == 1 else "")
+    if any(k in settings for k in INTERFACE_KEYS):
+        observed = observed_names(base, settings)
+        slots = tuple(observe_column(base, v)[0] for v in observed)
+        out = (_range(settings, "obs_low"), _range(settings, "obs_high"))
+        scaled = "scaled" if out == (-1.0, 1.0) else f"scaled to [{out[0]:g}, {out[1]:g}]"
+        text = ", ".join(
+            v if "(" in v and scaled == "scaled" else f"{v} {scaled}" for v in observed
+        )
+        if len(slots) == 1:
+            lo, hi = _range(settings, "noise_low"), _range(settings, "noise_high")
+            text += ", noise" if (lo, hi) == (0.0, 1.0) else f", noise U[{lo:g}, {hi:g}]"
         spec = replace(spec, observed_slots=slots, observed=text)
     if float(settings.get("noise", 0.0)) > 0.0:
         spec = replace(spec, observed=f"{spec.observed}; observation noise sd {settings['noise']}")
@@ -231,13 +317,29 @@ def obs_noise_sd(spec: TaskSpec) -> float:
     return float(parse(spec.name)[1].get("noise", 0.0)) if spec.base else 0.0
 
 
-def _observe_columns(spec: TaskSpec) -> tuple[tuple[int, float, float, bool], ...] | None:
-    if spec.base and "observe" in parse(spec.name)[1]:
-        return tuple(
-            (s, spec.state_low[s], spec.state_high[s], s in spec.angle_slots)
-            for s in spec.observed_slots
-        )
+def _observe_columns(spec: TaskSpec) -> tuple[tuple[int, float, float, int], ...] | None:
+    base, settings = parse(spec.name)
+    if any(k in settings for k in INTERFACE_KEYS):
+        return tuple(observe_column(base, v) for v in observed_names(base, settings))
     return None
+
+
+def _ranges(spec: TaskSpec, low: str, high: str) -> tuple[float, float]:
+    settings = parse(spec.name)[1]
+    return _range(settings, low), _range(settings, high)
+
+
+def observation_bounds(task: int | str) -> tuple[np.ndarray, np.ndarray]:
+    """The low and high bound of each of a task's two inputs (-1, 1 unless a range is set)."""
+    spec = spec_of(task)
+    low, high = np.full(2, -1.0), np.full(2, 1.0)
+    if spec.base:
+        settings = parse(spec.name)[1]
+        n = len(spec.observed_slots)
+        low[:n], high[:n] = _range(settings, "obs_low"), _range(settings, "obs_high")
+        if n == 1 and ("noise_low" in settings or "noise_high" in settings):
+            low[1], high[1] = _range(settings, "noise_low"), _range(settings, "noise_high")
+    return low, high
 
 
 def resolve(name: str) -> int:
@@ -261,6 +363,8 @@ def resolve(name: str) -> int:
                 _observe_columns(spec),
                 obs_noise_sd(spec),
                 len(spec.observed_slots),
+                _ranges(spec, "obs_low", "obs_high"),
+                _ranges(spec, "noise_low", "noise_high"),
             )
         )
         _IDS[key] = VARIANT_ID_BASE + len(_VARIANTS) - 1

@@ -14,6 +14,7 @@ A directory is an mtpg run directory when it holds ``config.toml`` and ``checkpo
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import os
 import shutil
@@ -416,12 +417,48 @@ def canonical_tasks(task_names: Iterable[str]) -> tuple[str, ...]:
     return tuple(sorted(names, key=order_key))
 
 
+#: Longest champion file name written (bytes): file systems allow 255, and the atomic
+#: writer adds a leading dot and a temporary suffix.
+MAX_FILENAME = 200
+
+
+def split_subset(text: str) -> list[str]:
+    """The task names of a subset written ``A+B+C``.
+
+    A ``+`` inside a variant's brackets (``Pendulum[observe=cos(theta)+sin(theta)]``) does
+    not split.
+    """
+    names, depth, start = [], 0, 0
+    for i, c in enumerate(text):
+        depth += (c == "[") - (c == "]")
+        if c == "+" and depth == 0:
+            names.append(text[start:i])
+            start = i + 1
+    names.append(text[start:])
+    return names
+
+
+def _digest(text: str, n: int) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:n]
+
+
 def champion_filename(task_names: tuple[str, ...]) -> str:
     """File name of the champion of a task subset: tasks in canonical order joined by "+".
 
-    Example: ``("Acrobot", "CartPole")`` gives ``"CartPole+Acrobot.json"``.
+    Example: ``("Acrobot", "CartPole")`` gives ``"CartPole+Acrobot.json"``. A name longer
+    than :data:`MAX_FILENAME` bytes (long variant names) writes each variant as its base
+    and a hash of its name (``MountainCar[1f0c2e9a]``), and if that is still too long the
+    subset as ``6-tasks-HASH.json``; the file's ``tasks`` entry names the subset in full
+    (:func:`read_champions` reads it back).
     """
-    return "+".join(canonical_tasks(task_names)) + ".json"
+    tasks = canonical_tasks(task_names)
+    full = "+".join(tasks) + ".json"
+    if len(full.encode()) <= MAX_FILENAME:
+        return full
+    short = "+".join(t if "[" not in t else f"{t.split('[')[0]}[{_digest(t, 8)}]" for t in tasks)
+    if len(short.encode()) + 5 <= MAX_FILENAME:
+        return short + ".json"
+    return f"{len(tasks)}-tasks-{_digest(full, 16)}.json"
 
 
 def write_champions(
@@ -461,8 +498,15 @@ def read_champions(
         return out
     for path in sorted(directory.glob("*.json")):
         try:
-            tasks = canonical_tasks(path.stem.split("+"))
-        except ValueError:
-            continue  # not a champion file
+            tasks = canonical_tasks(split_subset(path.stem))
+        except ValueError:  # a shortened name (long variants), or not a champion file
+            try:
+                graph = load_graph(path)
+                tasks = canonical_tasks(graph[2]["tasks"])
+            except (ValueError, KeyError, TypeError):
+                continue
+            if champion_filename(tasks) == path.name:
+                out[tasks] = graph
+            continue
         out[tasks] = load_graph(path)
     return out

@@ -18,7 +18,7 @@ import numpy as np
 from mtpg.analysis.plotting import finish, pyplot, save
 from mtpg.analysis.runs.loading import RunGroup
 from mtpg.analysis.runs.reported_numbers import RunNumbers, describe
-from mtpg.io.rundir import METRICS_FILE, TESTS_FILE
+from mtpg.io.rundir import METRICS_FILE, TESTS_FILE, split_subset
 
 
 def _read(path: Path) -> list[dict[str, str]]:
@@ -51,7 +51,7 @@ def hierarchy_statistics(run_dir: str | Path) -> dict[str, np.ndarray]:
         raise ValueError(f"{tests}: no test results yet")
     out = {
         "test_generation": np.array([float(r["generation"]) for r in rows]),
-        "subset_size": np.array([len(r["subset"].split("+")) for r in rows]),
+        "subset_size": np.array([len(split_subset(r["subset"])) for r in rows]),
         "teams_per_decision": np.array([float(r["teams_per_decision"]) for r in rows]),
         "graph_teams": np.array([float(r["graph_teams"]) for r in rows]),
     }
@@ -92,7 +92,7 @@ def subset_complexity(group: RunGroup, numbers: dict[Path, RunNumbers], path: Pa
     tasks = runs[0].tasks
     subsets = sorted(
         {str(r["subset"]) for r in runs[0].tests},
-        key=lambda s: (s.count("+"), [tasks.index(t) for t in s.split("+")]),
+        key=lambda s: (len(split_subset(s)), [tasks.index(t) for t in split_subset(s)]),
     )
     values = np.array(
         [
@@ -116,7 +116,7 @@ def subset_complexity(group: RunGroup, numbers: dict[Path, RunNumbers], path: Pa
         )
     ax.set_xticks(xs)
     ax.set_xticklabels(
-        ["+".join(str(tasks.index(t)) for t in s.split("+")) for s in subsets],
+        ["+".join(str(tasks.index(t)) for t in split_subset(s)) for s in subsets],
         rotation=90 if len(subsets) > 12 else 0,
         fontsize=6 if len(subsets) > 31 else 7,
     )

@@ -7,7 +7,8 @@ grow over many sittings, machines and commits. Each call of this script::
     .venv/bin/python tools/grow_results.py --budget 150          # minutes
 
 continues the unfinished runs of :data:`PLAN` (or, with ``--plan demo``, of
-:data:`DEMO_PLAN` in ``results/candidates``) in order, ``--parallel`` at a time, each an
+:data:`DEMO_PLAN` in ``results/candidates``, ``--plan variants`` of :data:`VARIANTS_PLAN` in
+``results/variants``) in order, ``--parallel`` at a time, each an
 ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun). Every
 ``--slice`` minutes, and when the budget is spent or the script is stopped (SIGTERM,
 SIGINT, SIGHUP), the runs are sent SIGTERM, so each commits the generation under way and
@@ -59,10 +60,51 @@ DEMO_PLAN: tuple[tuple[str, int, str | None], ...] = tuple(
     for s in range(1, 6)  # seed by seed, so that the pairs to compare grow together
     for run in ((f"demo-seed{s}", s, None), (f"demo-resample10-seed{s}", s, "resample10"))
 )
+#: The interface study (issue 40, item 3, docs/variants-study.md): CartCentering +
+#: MountainCar with the paper's interface and with the authors' code's, and the six tasks
+#: with the authors' (the six with the paper's are the candidates' ``demo-seedN``), seeds
+#: 1 to 3 of ``demo``, 1,000 generations, in ``results/variants`` (``--plan variants``).
+VARIANTS_PLAN: tuple[tuple[str, int, str | None], ...] = tuple(
+    run
+    for s in range(1, 4)
+    for run in (
+        (f"ccmc-paper-seed{s}", s, "ccmc-paper"),
+        (f"ccmc-authors-seed{s}", s, "ccmc-authors"),
+        (f"six-authors-seed{s}", s, "six-authors"),
+    )
+)
+#: The authors' code's observation interface, as variants of the paper's tasks
+#: (../shared/reference/tpg-cpp-anchors.md, section 2: MountainCar's position in [0, 1] and
+#: U[-pi, pi] noise, unnormalised; CartCentering's noise U[-pi, pi]/pi; Pendulum observing
+#: cos and sin of its angle, 300 steps).
+AUTHORS_TASKS = {
+    "CartPole": "CartPole",
+    "Acrobot": "Acrobot",
+    "CartCentering": "CartCentering[noise_high=1;noise_low=-1]",
+    "Pendulum": "Pendulum[max_steps=300;observe=cos(theta)+sin(theta)]",
+    "MountainCar": "MountainCar[noise_high=pi;noise_low=-pi;obs_high=1;obs_low=0]",
+    "MountainCarContinuous": (
+        "MountainCarContinuous[noise_high=pi;noise_low=-pi;obs_high=1;obs_low=0]"
+    ),
+}
 #: Each plan: its preset, and where its runs go unless ``--results`` says otherwise.
-PLANS = {"paper": ("paper", "results"), "demo": ("demo", "results/candidates")}
+PLANS = {
+    "paper": ("paper", "results"),
+    "demo": ("demo", "results/candidates"),
+    "variants": ("demo", "results/variants"),
+}
+#: The runs of each plan.
+PLAN_RUNS = {"paper": PLAN, "demo": DEMO_PLAN, "variants": VARIANTS_PLAN}
 #: What a plan entry's variant adds to ``mtpg train`` (any other: ``--VARIANT``).
-VARIANT_ARGS = {"resample10": ["--set", "evaluation.resample_interval=10"]}
+VARIANT_ARGS = {
+    "resample10": ["--set", "evaluation.resample_interval=10"],
+    "ccmc-paper": ["--tasks", "CartCentering,MountainCar"],
+    "ccmc-authors": [
+        "--tasks",
+        ",".join(AUTHORS_TASKS[t] for t in ("CartCentering", "MountainCar")),
+    ],
+    "six-authors": ["--tasks", ",".join(AUTHORS_TASKS.values())],
+}
 #: Test-point folders kept: generations divisible by this, and the newest.
 KEEP_TESTS_EVERY = 100
 #: Seconds a run is given to commit after SIGTERM before it is told to stop at once.
@@ -283,7 +325,8 @@ def main(argv: list[str] | None = None) -> int:
         "--plan",
         choices=sorted(PLANS),
         default="paper",
-        help="the paper's experiment (paper) or the demo-scale candidates (demo)",
+        help="the paper's experiment (paper), the demo-scale candidates (demo) or the "
+        "interface study (variants)",
     )
     p.add_argument(
         "--results", type=Path, default=None, help="folder (results; demo: results/candidates)"
@@ -303,7 +346,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = p.parse_args(argv)
     args.results = (args.results or Path(PLANS[args.plan][1])).resolve()
-    plan = PLAN if args.plan == "paper" else DEMO_PLAN
+    plan = PLAN_RUNS[args.plan]
     args.results.mkdir(parents=True, exist_ok=True)
     repo = Path(sh("git", "rev-parse", "--show-toplevel", cwd=args.results))
     commit = "unchecked" if args.unchecked else source_commit(args.python, repo)

@@ -6,7 +6,8 @@ grow over many sittings, machines and commits. Each call of this script::
 
     .venv/bin/python tools/grow_results.py --budget 150          # minutes
 
-continues the unfinished runs of :data:`PLAN` (or, with ``--plan demo``, of
+continues the unfinished runs of :data:`PLAN` (or, with ``--plan robust``, of
+:data:`ROBUST_PLAN` beside them; with ``--plan demo``, of
 :data:`DEMO_PLAN` in ``results/candidates``, ``--plan variants`` of :data:`VARIANTS_PLAN` in
 ``results/variants``) in order, ``--parallel`` at a time, each an
 ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun). Every
@@ -52,6 +53,12 @@ PLAN: tuple[tuple[str, int, str | None], ...] = (
     ("TPG-NoMemory-seed1", 1, "no-memory"),
     ("TPG-NoHierarchy-seed1", 1, "no-hierarchy"),
 )
+#: TPG-robust at the paper's scale (issue 40, item 2): the ``robust`` preset (``paper`` with
+#: the training episodes redrawn every 10 generations), seeds 1 to 5, beside the TPG runs
+#: in ``results/runs`` (``--plan robust``).
+ROBUST_PLAN: tuple[tuple[str, int, str | None], ...] = tuple(
+    (f"TPG-robust-seed{s}", s, None) for s in range(1, 6)
+)
 #: The demo-scale candidates for the memorisation study (issue 40): six tasks, 1,000
 #: generations, five seeds of ``demo`` as it is and with the training episodes redrawn
 #: every 10 generations (``robust``'s rule), in ``results/candidates`` (``--plan demo``).
@@ -90,11 +97,18 @@ AUTHORS_TASKS = {
 #: Each plan: its preset, and where its runs go unless ``--results`` says otherwise.
 PLANS = {
     "paper": ("paper", "results"),
+    "robust": ("robust", "results"),
     "demo": ("demo", "results/candidates"),
     "variants": ("demo", "results/variants"),
 }
-#: The runs of each plan.
-PLAN_RUNS = {"paper": PLAN, "demo": DEMO_PLAN, "variants": VARIANTS_PLAN}
+
+
+def plan_runs(plan: str) -> tuple[tuple[str, int, str | None], ...]:
+    """The runs of a plan (looked up when called, so tests may replace a plan)."""
+    plans = {"paper": PLAN, "robust": ROBUST_PLAN, "demo": DEMO_PLAN, "variants": VARIANTS_PLAN}
+    return plans[plan]
+
+
 #: What a plan entry's variant adds to ``mtpg train`` (any other: ``--VARIANT``).
 VARIANT_ARGS = {
     "resample10": ["--set", "evaluation.resample_interval=10"],
@@ -325,8 +339,8 @@ def main(argv: list[str] | None = None) -> int:
         "--plan",
         choices=sorted(PLANS),
         default="paper",
-        help="the paper's experiment (paper), the demo-scale candidates (demo) or the "
-        "interface study (variants)",
+        help="the paper's experiment (paper), TPG-robust (robust), the demo-scale candidates "
+        "(demo) or the interface study (variants)",
     )
     p.add_argument(
         "--results", type=Path, default=None, help="folder (results; demo: results/candidates)"
@@ -346,7 +360,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = p.parse_args(argv)
     args.results = (args.results or Path(PLANS[args.plan][1])).resolve()
-    plan = PLAN_RUNS[args.plan]
+    plan = plan_runs(args.plan)
     args.results.mkdir(parents=True, exist_ok=True)
     repo = Path(sh("git", "rev-parse", "--show-toplevel", cwd=args.results))
     commit = "unchecked" if args.unchecked else source_commit(args.python, repo)

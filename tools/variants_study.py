@@ -1,0 +1,174 @@
+"""Score the interface study of ``results/variants`` and write its table and figure.
+
+The study (issue 40, item 3) asks how much of the paper's result the observation
+interface of the authors' published code could explain: CartCentering + MountainCar and
+the six tasks, each with the paper's interface and with the code's
+(``tools/grow_results.py``: :data:`AUTHORS_TASKS`), ``demo`` preset, seeds 1 to 3, 1,000
+generations. The six tasks with the paper's interface are the candidates' runs
+``results/candidates/runs/demo-seed1..3`` (the same preset and seeds).
+
+For every finished run the all-task champion is played on 100 held-out episodes per task
+(``mtpg evaluate RUN --episodes 100 --json``), and on CartCentering's held-out episodes
+traced (:func:`mtpg.engine.trace.trace_episode`) to count the episodes that leave the
+track (``|x| > 1.5``) and, of those, the share that started left of centre: the
+signature of CartCentering played as MountainCar. The figures go to
+``results/variants/variants.json``, the table between the markers of
+``docs/variants-study.md``, the figure to ``docs/img/variants-study.png``::
+
+    .venv/bin/python tools/variants_study.py
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from mtpg.analysis.plotting import pyplot, save
+from mtpg.analysis.runs.champions import run_champion
+from mtpg.analysis.runs.statistics import aggregate_iqm, per_task_iqm
+from mtpg.engine.batch import Episodes
+from mtpg.engine.compile import compile_population
+from mtpg.engine.trace import trace_episode
+from mtpg.envs.protocol import held_out_seeds
+from mtpg.envs.variants import resolve
+from mtpg.io.runconfig import read_run_config
+from mtpg.io.serialize import load_graph
+
+ROOT = Path(__file__).resolve().parent.parent
+FOLDER = ROOT / "results" / "variants"
+DOC = ROOT / "docs" / "variants-study.md"
+FIGURE = ROOT / "docs" / "img" / "variants-study.png"
+#: Each group: its label and where its runs are (folder, name prefix).
+GROUPS = {
+    "CC+MC, paper": (FOLDER / "runs", "ccmc-paper-seed"),
+    "CC+MC, authors' code": (FOLDER / "runs", "ccmc-authors-seed"),
+    "six tasks, paper": (ROOT / "results" / "candidates" / "runs", "demo-seed"),
+    "six tasks, authors' code": (FOLDER / "runs", "six-authors-seed"),
+}
+SEEDS = (1, 2, 3)
+EPISODES = 100
+BEGIN, END = "<!-- variants table: begin -->", "<!-- variants table: end -->"
+
+
+def finished(run: Path) -> bool:
+    """Whether the run has reached the generations of its configuration."""
+    if not (run / "config.toml").is_file():
+        return False
+    target = tomllib.loads((run / "config.toml").read_text())["generations"]
+    lines = (run / "metrics.csv").read_text().splitlines()
+    return len(lines) > 1 and int(lines[-1].split(",")[0]) >= target
+
+
+def scores(run: Path) -> dict[str, float]:
+    """The all-task champion's normalised score per task (base names) on held-out episodes."""
+    out = subprocess.run(
+        [sys.executable, "-m", "mtpg", "evaluate", str(run), "--episodes", str(EPISODES)]
+        + ["--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    return {task.split("[")[0]: row["normalised"] for task, row in json.loads(out).items()}
+
+
+def off_track(run: Path) -> tuple[float, float]:
+    """CartCentering's held-out episodes: the share leaving the track (and of those, from x < 0)."""
+    pop, root, _ = load_graph(run_champion(run))
+    tasks = read_run_config(run).evaluation.tasks
+    name = next(t for t in tasks if t.split("[")[0] == "CartCentering")
+    task = resolve(name)
+    cp = compile_population(pop, fold_constants=False)
+    table = Episodes.grid([task], held_out_seeds(EPISODES).tolist())
+    left, from_left = 0, 0
+    for e in range(EPISODES):
+        states = trace_episode(cp, root, task, table.starts[e], table.noise[e]).states
+        if abs(states[-1, 0]) > 1.5:
+            left += 1
+            from_left += int(states[0, 0] < 0)
+    return left / EPISODES, (from_left / left if left else float("nan"))
+
+
+def collect() -> dict[str, dict[str, dict]]:
+    """Every finished run's scores and CartCentering behaviour, by group."""
+    out: dict[str, dict[str, dict]] = {}
+    for group, (folder, prefix) in GROUPS.items():
+        out[group] = {}
+        for s in SEEDS:
+            run = folder / f"{prefix}{s}"
+            if finished(run):
+                share, left = off_track(run)
+                out[group][run.name] = {"scores": scores(run), "off_track": share, "left": left}
+        print(f"{group}: {len(out[group])} of {len(SEEDS)} runs finished", flush=True)
+    return out
+
+
+def table(results: dict[str, dict[str, dict]]) -> str:
+    """The markdown section: per run, then per group."""
+    lines = []
+    for group, runs in results.items():
+        if not runs:
+            lines += [f"**{group}**: no finished run yet.", ""]
+            continue
+        tasks = list(next(iter(runs.values()))["scores"])
+        lines += [f"**{group}**", ""]
+        lines.append("| run | " + " | ".join(tasks) + " | CC off track | of which x0 < 0 |")
+        lines.append("|---|" + "---|" * (len(tasks) + 2))
+        for name, r in runs.items():
+            row = " | ".join(f"{r['scores'][t]:.2f}" for t in tasks)
+            lines.append(f"| {name} | {row} | {r['off_track']:.0%} | {r['left']:.0%} |")
+        m = np.array([[r["scores"][t] for t in tasks] for r in runs.values()])
+        per = " | ".join(e.text() for e in per_task_iqm(m))
+        lines.append(f"| IQM [95% CI], {len(m)} runs | {per} | | |")
+        lines += ["", f"IQM over runs and tasks: {aggregate_iqm(m).text()}", ""]
+    return "\n".join(lines)
+
+
+def figure(results: dict[str, dict[str, dict]]) -> None:
+    """Per task IQM over runs (bars) with 95% intervals, each group a colour."""
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(9, 4))
+    order = ["CartPole", "Acrobot", "CartCentering", "Pendulum", "MountainCar"]
+    order.append("MountainCarContinuous")
+    groups = [g for g, runs in results.items() if runs]
+    width = 0.8 / max(1, len(groups))
+    for k, group in enumerate(groups):
+        runs = results[group].values()
+        tasks = [t for t in order if t in next(iter(runs))["scores"]]
+        m = np.array([[r["scores"][t] for t in tasks] for r in runs])
+        est = per_task_iqm(m)
+        x = np.array([order.index(t) for t in tasks]) + (k - (len(groups) - 1) / 2) * width
+        mid = np.array([e.value for e in est])
+        err = np.array([[e.value - e.low for e in est], [e.high - e.value for e in est]])
+        ax.bar(x, mid, width, yerr=err, capsize=2, label=f"{group} ({len(m)} runs)")
+    ax.set_xticks(range(len(order)), [t.replace("MountainCar", "MC") for t in order])
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.set_ylabel("normalised score, IQM over runs")
+    ax.set_title("All-task champions, 100 held-out episodes per task (demo, 1,000 generations)")
+    ax.legend(fontsize=8, ncol=2)
+    fig.tight_layout()
+    save(fig, FIGURE)
+
+
+def main() -> int:
+    """Scores the finished runs, rewrites the doc's table and the figure."""
+    results = collect()
+    if not any(results.values()):
+        print("no finished run", file=sys.stderr)
+        return 1
+    FOLDER.mkdir(parents=True, exist_ok=True)
+    (FOLDER / "variants.json").write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
+    text = DOC.read_text()
+    head, _, rest = text.partition(BEGIN)
+    _, _, tail = rest.partition(END)
+    DOC.write_text(f"{head}{BEGIN}\n{table(results)}\n{END}{tail}")
+    figure(results)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

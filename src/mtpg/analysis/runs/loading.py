@@ -26,7 +26,7 @@ import numpy as np
 from mtpg.ablations import ABLATION_FIELDS, experiment_label
 from mtpg.config import RunConfig, to_dict
 from mtpg.envs.reference import normalise, reference_of
-from mtpg.envs.task_table import TaskTable
+from mtpg.envs.task_table import REGISTERED, TaskTable
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_FILE
 
@@ -189,14 +189,15 @@ def group_runs(runs: list[RunData]) -> tuple[list[RunGroup], list[str]]:
 
 
 def normalise_scores(
-    scores: dict[str, float], best: dict[str, float], table: TaskTable
+    scores: dict[str, float], best: dict[str, float], table: TaskTable = REGISTERED
 ) -> dict[str, float]:
     """``(score - random) / (best - random)`` per task; NaN when ``best`` equals random.
 
     Args:
         scores: Scores by task name.
         best: The best score of each task to normalise against.
-        table: The task table of the names (the run's: its given reference scores).
+        table: The task table of the names (the run's: its given reference scores); the
+            registered tasks by default (a variant's name is refused there).
     """
     out = {}
     for task, score in scores.items():

@@ -21,8 +21,6 @@ import numpy as np
 
 from mtpg.analysis.runs.champions import champion_path, tested_run
 from mtpg.analysis.runs.memorisation import Probe, probe_target, probe_text
-from mtpg.envs.reference import normalise
-from mtpg.envs.variants import resolve
 from mtpg.evolve.memorisation import DEFAULT_REDRAWS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,8 +54,7 @@ def fresh_interval(probe: Probe, task: str) -> tuple[float, float, float, float]
     The interval is the mean over redraws -+ 1.96 standard errors; the central 95% runs
     from the 2.5th to the 97.5th percentile of the means of single redraws.
     """
-    tid = resolve(task)
-    values = [float(normalise(tid, v)) for v in probe.tasks[task].redraw_means]
+    values = [probe.tasks[task].normalise(v) for v in probe.tasks[task].redraw_means]
     mean = statistics.fmean(values)
     half = 1.96 * statistics.stdev(values) / len(values) ** 0.5
     low, high = np.percentile(values, [2.5, 97.5])

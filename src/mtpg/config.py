@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.ablations import ABLATIONS as ABLATIONS  # re-exported: the table lives there
-from mtpg.envs.reference import give_reference, parse_given
 from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
-from mtpg.envs.variants import canonical, from_tables, is_variant, resolve
+from mtpg.envs.task_table import TaskTable, parse_given
+from mtpg.envs.variants import canonical, from_tables, is_variant
 from mtpg.limits import LIMITS
 from mtpg.presets import BACKENDS, PARENT_SELECTIONS, PRESETS
 from mtpg.presets import EXTENSIONS as EXTENSIONS
@@ -184,7 +184,8 @@ class EvaluationConfig:
     ``"TASK: best=NUMBER[, random=NUMBER], source=TEXT"`` (``[[task]]`` tables take
     ``reference = {best = ..., source = "..."}``). A variant without one is normalised
     against its base task's best with a measured random score
-    (:func:`mtpg.envs.reference.reference_of`)."""
+    (:func:`mtpg.envs.reference.reference_of`, given the run's
+    :meth:`task_table`)."""
 
     def __post_init__(self) -> None:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
@@ -225,7 +226,7 @@ class EvaluationConfig:
         self._check_references()
 
     def _check_references(self) -> None:
-        """Validates ``references`` and gives them to :mod:`mtpg.envs.reference`."""
+        """Validates ``references`` (changing nothing: the task table holds them)."""
         seen = set()
         for text in self.references:
             _check(isinstance(text, str), "evaluation.references", "must hold text", text)
@@ -241,20 +242,23 @@ class EvaluationConfig:
             )
             _check(given.task not in seen, "evaluation.references", "gives a task twice", text)
             seen.add(given.task)
-            try:
-                give_reference(given)
-            except ValueError as exc:
-                raise ConfigError(f"evaluation.references: {exc}") from None
 
     @property
     def n_subsets(self) -> int:
         """Number of non-empty task subsets."""
         return 2 ** len(self.tasks) - 1
 
+    def task_table(self) -> TaskTable:
+        """The task table of the active tasks and their given reference scores.
+
+        A new value on every call: build it once per run and pass it on.
+        """
+        return TaskTable.from_names(self.tasks, self.references)
+
     @property
     def task_ids(self) -> tuple[int, ...]:
-        """Task ids of the active tasks, in configuration order (variants' ids resolved)."""
-        return tuple(resolve(t) for t in self.tasks)
+        """Task ids of the active tasks in their task table, in configuration order."""
+        return self.task_table().ids
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

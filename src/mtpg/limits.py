@@ -113,10 +113,8 @@ def training_estimate(config: Any) -> dict[str, float]:
         ``checkpoint``, ``base`` and ``total`` bytes, and ``decisions`` (upper bound of one
         generation, validation and re-evaluation of survivors included).
     """
-    from mtpg.envs.variants import spec_of
-
     ev, team, prog = config.evaluation, config.team, config.program
-    steps = [spec_of(t).max_steps for t in ev.task_ids]
+    steps = [spec.max_steps for spec in ev.task_table().specs]
     subsets = ev.n_subsets
     children = config.elites_per_subset * subsets
     roots = max(team.root_size, 2 * children)  # kept elites plus new children

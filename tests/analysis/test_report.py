@@ -17,6 +17,7 @@ from mtpg.analysis.runs.reported_numbers import best_of, best_single_task, run_n
 from mtpg.cli.main import main
 from mtpg.envs.core import CARTCENTERING, TASK_NAMES
 from mtpg.envs.reference import REFERENCE, measure_random, measure_time_optimal_cartcentering
+from mtpg.envs.task_table import TaskTable
 from mtpg.io.serialize import load_graph
 from tinyruns import tiny_args
 
@@ -217,13 +218,14 @@ def test_normalisation_is_0_for_random_and_1_for_the_reference_controller():
     best, _, captured = measure_time_optimal_cartcentering()
     assert captured == 100
     task = TASK_NAMES[CARTCENTERING]
-    ref = reference_best((task,))
-    assert normalise_scores({task: best}, ref)[task] == pytest.approx(1.0, abs=1e-12)
+    table = TaskTable.from_names([task])
+    ref = reference_best(table)
+    assert normalise_scores({task: best}, ref, table)[task] == pytest.approx(1.0, abs=1e-12)
     stored = REFERENCE[CARTCENTERING].random
-    assert normalise_scores({task: stored}, ref)[task] == 0.0
+    assert normalise_scores({task: stored}, ref, table)[task] == 0.0
     # a fresh random agent, on other episodes, scores close to 0
     mean, std = measure_random(CARTCENTERING, n=2000, seed=7, seed_base=5_000_000)
-    assert abs(normalise_scores({task: mean}, ref)[task]) < 0.05
+    assert abs(normalise_scores({task: mean}, ref, table)[task]) < 0.05
 
 
 def test_mixture_warning_is_a_python_warning(runs, twelve, monkeypatch, tmp_path):

@@ -13,7 +13,7 @@ from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.dask_backend import DaskEvaluator, plan_batches
 from mtpg.engine.workload import tangled_population
-from mtpg.envs.variants import resolve
+from mtpg.envs.task_table import TaskTable
 from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
 
 TINY = [
@@ -64,8 +64,8 @@ def test_batches_equal_the_local_engine(cluster, no_memory):
     cp = compile_population(pop)
     roots = sorted(pop.teams)[::2]
     # a variant too: the workers never resolve its name, its row travels with the episodes
-    variant = resolve("Pendulum[max_steps=30;observe=theta_dot]")
-    eps = Episodes.grid([0, 1, 2, 4, variant], [0, 1, 2])
+    table = TaskTable.from_names(["Pendulum[max_steps=30;observe=theta_dot]"])
+    eps = Episodes.grid([0, 1, 2, 4, table.ids[0]], [0, 1, 2], table)
     want, w = evaluate_roots(cp, roots, eps, 1, no_memory)
     got, g = cluster.evaluate(cp, roots, eps, no_memory)
     assert np.array_equal(want, got)

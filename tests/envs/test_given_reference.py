@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from mtpg.config import ConfigError, build_config, from_dict, to_dict, to_toml
-from mtpg.envs.reference import GivenReference, normalise, parse_given, reference_of
-from mtpg.envs.variants import resolve
+from mtpg.envs.reference import normalise, reference_of
+from mtpg.envs.task_table import GivenReference, TaskTable, parse_given
 from mtpg.evolve.persist import identity_fields, run_identity
 
 
@@ -51,11 +51,12 @@ def test_a_task_table_gives_the_reference_and_it_normalises(tmp_path):
     name = "CartPole[max_steps=401]"
     assert cfg.evaluation.tasks == (name, "Acrobot")
     assert cfg.evaluation.references == (f"{name}: best=401, random=21.0, source=the time limit",)
-    ref = reference_of(name)
+    table = cfg.evaluation.task_table()
+    ref = reference_of(name, table)
     assert (ref.best, ref.random) == (401.0, 21.0)
     assert math.isnan(ref.random_std)
     assert ref.source == "random given; best given: the time limit"
-    assert normalise(resolve(name), 211.0) == pytest.approx((211.0 - 21.0) / 380.0)
+    assert normalise(table.id_of(name), 211.0, table=table) == pytest.approx((211.0 - 21.0) / 380.0)
     again = tmp_path / "again.toml"
     again.write_text(to_toml(cfg))
     assert build_config("demo", again) == cfg
@@ -65,8 +66,7 @@ def test_a_task_table_gives_the_reference_and_it_normalises(tmp_path):
 def test_without_random_the_random_score_is_measured():
     name = "Pendulum[max_steps=57]"
     data = {"evaluation": {"tasks": [name], "references": [f"{name}: best=-10, source=guess"]}}
-    from_dict(data)
-    ref = reference_of(name)
+    ref = reference_of(name, from_dict(data).evaluation.task_table())
     assert ref.best == -10.0 and ref.source == "random measured; best given: guess"
     assert np.isfinite(ref.random) and ref.random_std > 0
 
@@ -88,12 +88,16 @@ def test_a_bad_config_entry_names_the_field(references, fault):
         from_dict(data)
 
 
-def test_two_different_references_for_one_variant_are_refused():
+def test_two_runs_keep_their_own_references_and_validating_changes_nothing():
     name = "MountainCar[max_steps=99]"
-    from_dict({"evaluation": {"tasks": [name], "references": [f"{name}: best=-50, source=a"]}})
-    from_dict({"evaluation": {"tasks": [name], "references": [f"{name}: best=-50, source=a"]}})
-    with pytest.raises(ConfigError, match="already given differently"):
-        from_dict({"evaluation": {"tasks": [name], "references": [f"{name}: best=-60, source=b"]}})
+    a = from_dict({"evaluation": {"tasks": [name], "references": [f"{name}: best=-50, source=a"]}})
+    b = from_dict({"evaluation": {"tasks": [name], "references": [f"{name}: best=-60, source=b"]}})
+    plain = from_dict({"evaluation": {"tasks": [name]}})
+    assert reference_of(name, a.evaluation.task_table()).best == -50.0
+    assert reference_of(name, b.evaluation.task_table()).best == -60.0
+    assert reference_of(name, plain.evaluation.task_table()).best == -110.0  # the base's
+    with pytest.raises(ValueError, match="not in the run"):
+        TaskTable.from_names(["CartPole"], [f"{name}: best=-50, source=a"])
 
 
 def test_references_enter_the_identity_only_when_given():

@@ -19,14 +19,9 @@ from mtpg.engine.compile import compile_population
 from mtpg.engine.reference import ReferenceAgent, reference_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe
-from mtpg.envs.variants import (
-    canonical,
-    observation_bounds,
-    register,
-    resolve,
-    spec_of,
-    task_params,
-)
+from mtpg.envs.registration import register
+from mtpg.envs.task_table import TaskTable
+from mtpg.envs.variants import canonical, observation_bounds, task_spec
 
 MC = "MountainCar[noise_high=pi;noise_low=-pi;obs_high=1;obs_low=0]"
 CC = "CartCentering[noise_high=1;noise_low=-1]"
@@ -38,9 +33,9 @@ def test_names_are_canonical_with_pi_spelled_out() -> None:
         "MountainCar[noise_high=3.141592653589793;noise_low=-3.141592653589793;"
         "obs_high=1.0;obs_low=0.0]"
     )
-    assert spec_of(resolve(MC)).observed == "position scaled to [0, 1], noise U[-3.14159, 3.14159]"
-    assert spec_of(resolve(PEND)).observed == "cos(theta), sin(theta)"
-    assert spec_of(resolve(CC)).observed == "x scaled, noise U[-1, 1]"
+    assert task_spec(MC).observed == "position scaled to [0, 1], noise U[-3.14159, 3.14159]"
+    assert task_spec(PEND).observed == "cos(theta), sin(theta)"
+    assert task_spec(CC).observed == "x scaled, noise U[-1, 1]"
 
 
 @pytest.mark.parametrize(
@@ -61,8 +56,9 @@ def test_contradictions_are_refused_naming_the_key(text: str, message: str) -> N
 
 
 def test_the_inputs_take_the_ranges_the_variant_sets() -> None:
-    mc, cc, pend = resolve(MC), resolve(CC), resolve(PEND)
-    params = task_params()
+    table = TaskTable.from_names([MC, CC, PEND])
+    mc, cc, pend = table.ids
+    params = table.params
     obs = np.zeros(2)
     for x, u in [(-1.2, 0.0), (0.6, 0.999), (-0.3, 0.5), (0.0, 0.123)]:
         env_observe(mc, params, np.array([x, 0.0, 0, 0, 0, 0, 0, 0.0]), u, obs)
@@ -74,14 +70,14 @@ def test_the_inputs_take_the_ranges_the_variant_sets() -> None:
         assert obs.tolist() == [math.cos(x * 7), math.sin(x * 7)]  # as they are
     env_observe(mc, params, np.array([np.nan, 0.0, 0, 0, 0, 0, 0, 0.0]), 0.5, obs)
     assert obs[0] == 0.5  # a NaN becomes the middle of the range
-    low, high = observation_bounds(mc)
+    low, high = observation_bounds(table.spec(mc))
     assert low.tolist() == [0.0, -math.pi] and high.tolist() == [1.0, math.pi]
-    assert observation_bounds(pend)[0].tolist() == [-1.0, -1.0]
+    assert observation_bounds(table.spec(pend))[0].tolist() == [-1.0, -1.0]
 
 
 def test_variants_without_the_keys_observe_as_before() -> None:
-    task = resolve("Pendulum[observe=theta]")
-    params = task_params()  # after resolving: the table has the variant's row
+    table = TaskTable.from_names(["Pendulum[observe=theta]"])
+    task, params = table.ids[0], table.params  # the table has the variant's row
     state = np.array([2.0, 4.0, 0, 0, 0, 0, 0, 0.0])
     obs = np.zeros(2)
     env_observe(task, params, state, 0.3, obs)
@@ -99,14 +95,20 @@ def test_interface_variants_pass_check_env(name: str) -> None:
 
 @pytest.mark.parametrize("name", [MC, CC, PEND])
 def test_engine_plays_them_like_the_reference_interpreter(name: str) -> None:
-    task = resolve(name)
+    table = TaskTable.from_names([name])
+    task = table.ids[0]
     pop = tangled_population(np.random.default_rng(4), 6, 20, 12, 4, 0.5)
     roots = list(pop.teams)[:3]
-    episodes = Episodes.grid([task], [0, 1])
+    episodes = Episodes.grid([task], [0, 1], table)
     returns, result = evaluate_roots(compile_population(pop), roots, episodes)
     for i, root in enumerate(roots):
         for e in range(2):
             total, steps = reference_episode(
-                ReferenceAgent(pop, root), task, episodes.starts[e], episodes.noise[e], None
+                ReferenceAgent(pop, root),
+                task,
+                episodes.starts[e],
+                episodes.noise[e],
+                None,
+                table.params,
             )
             assert returns[i, e] == total and result.steps[i * 2 + e] == steps

@@ -14,15 +14,9 @@ from mtpg.engine.trace import trace_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import PREV_FORCE_SLOT, env_observe, env_reset, env_step
 from mtpg.envs.core import CARTPOLE
-from mtpg.envs.variants import (
-    VARIANT_ID_BASE,
-    canonical,
-    gym_id,
-    register,
-    resolve,
-    spec_of,
-    task_params,
-)
+from mtpg.envs.registration import register
+from mtpg.envs.task_table import VARIANT_ID_BASE, TaskTable
+from mtpg.envs.variants import canonical, gym_id
 
 CP500 = "CartPole[max_steps=500]"
 
@@ -35,9 +29,10 @@ def test_canonical_names_and_gym_ids() -> None:
     )
     assert gym_id(CP500) == "mtpg/CartPole-max_steps_500-v0"
     assert gym_id("CartPole[observe=x+theta]") == "mtpg/CartPole-observe_x.theta-v0"
-    assert resolve("CartPole[max_steps=500.0]") == resolve(CP500) >= VARIANT_ID_BASE
-    assert resolve("CartPole") == CARTPOLE
-    spec = spec_of(CP500)
+    table = TaskTable.from_names([CP500, "CartPole"])
+    assert table.id_of("CartPole[max_steps=500.0]") == table.id_of(CP500) >= VARIANT_ID_BASE
+    assert table.id_of("CartPole") == CARTPOLE
+    spec = table.spec(CP500)
     assert spec.max_steps == 500 and spec.base == "CartPole" and spec.gym_id == gym_id(CP500)
     assert np.isnan(spec.reference.random)
 
@@ -69,7 +64,7 @@ def test_bad_variants_are_refused_in_one_line(text: str, message: str) -> None:
 def play(task: int, seed: int, actions) -> tuple[list[np.ndarray], list[tuple]]:
     from mtpg.envs import sample_start
 
-    params = task_params()
+    params = TaskTable.from_names([]).params
     state = np.zeros(6)
     env_reset(task, params, sample_start(task, np.random.default_rng(seed)), state)
     states, outcomes = [state.copy()], []
@@ -87,14 +82,14 @@ def balance(state: np.ndarray) -> int:
 
 
 def test_variant_reproduces_its_base_step_for_step_and_gymnasium_cartpole_v1() -> None:
-    v = resolve(CP500)
-    params = task_params()
+    table = TaskTable.from_names([CP500])
+    v, params = table.ids[0], table.params
     gym = gymnasium.make("CartPole-v1")  # Gymnasium's own 500-step CartPole
     for seed in range(3):
         from mtpg.envs import sample_start
 
         ours = np.zeros(6)
-        env_reset(v, params, sample_start(v, np.random.default_rng(seed)), ours)
+        env_reset(v, params, sample_start(v, np.random.default_rng(seed), table), ours)
         base = np.zeros(6)
         env_reset(CARTPOLE, params, sample_start(CARTPOLE, np.random.default_rng(seed)), base)
         gym.reset(seed=seed)
@@ -115,10 +110,15 @@ def test_variant_reproduces_its_base_step_for_step_and_gymnasium_cartpole_v1() -
 
 
 def test_observe_variant_scales_the_chosen_state_variables() -> None:
-    both = resolve("CartPole[observe=x_dot+theta_dot]")
-    one = resolve("Pendulum[observe=theta_dot]")
-    wrapped = resolve("Pendulum[observe=theta]")
-    params = task_params()  # after resolving: the table has the variants' rows
+    table = TaskTable.from_names(
+        [
+            "CartPole[observe=x_dot+theta_dot]",
+            "Pendulum[observe=theta_dot]",
+            "Pendulum[observe=theta]",
+        ]
+    )
+    both, one, wrapped = table.ids
+    params = table.params  # the table has the variants' rows
     state = np.array([0.3, 1.5, -0.1, -3.5, 10.0, 0.0])
     obs = np.zeros(2)
     env_observe(both, params, state, 0.25, obs)
@@ -151,10 +151,11 @@ def test_variant_environments_pass_check_env(name: str) -> None:
     ],
 )
 def test_engine_plays_a_variant_like_the_reference_interpreter(name: str) -> None:
-    task = resolve(name)
+    table = TaskTable.from_names([name])
+    task = table.ids[0]
     pop = tangled_population(np.random.default_rng(3), 6, 20, 12, 4, 0.5)
     roots = list(pop.teams)[:3]
-    episodes = Episodes.grid([task], [0, 1])
+    episodes = Episodes.grid([task], [0, 1], table)
     cp = compile_population(pop, fold_constants=False)  # traced below
     returns, result = evaluate_roots(compile_population(pop), roots, episodes)
     eps = episodes.obs_noise if episodes.obs_noise.shape[1] else [None, None]
@@ -162,10 +163,21 @@ def test_engine_plays_a_variant_like_the_reference_interpreter(name: str) -> Non
     for i, root in enumerate(roots):
         for e in range(2):
             total, steps = reference_episode(
-                ReferenceAgent(pop, root), task, episodes.starts[e], episodes.noise[e], eps[e]
+                ReferenceAgent(pop, root),
+                task,
+                episodes.starts[e],
+                episodes.noise[e],
+                eps[e],
+                table.params,
             )
             assert returns[i, e] == total and result.steps[i * 2 + e] == steps
             trace = trace_episode(
-                cp, root, task, episodes.starts[e], episodes.noise[e], obs_noise=eps[e]
+                cp,
+                root,
+                task,
+                episodes.starts[e],
+                episodes.noise[e],
+                obs_noise=eps[e],
+                params=table.params,
             )
-            assert len(trace.actions) == steps <= spec_of(task).max_steps
+            assert len(trace.actions) == steps <= table.spec(task).max_steps

@@ -14,7 +14,7 @@ import pytest
 
 from mtpg.config import build_config
 from mtpg.engine.batch import Episodes
-from mtpg.envs.variants import resolve
+from mtpg.envs.task_table import TaskTable
 from mtpg.evolve.memorisation import (
     champion_training_seeds,
     fresh_noise_episodes,
@@ -100,7 +100,7 @@ def memoriser() -> tuple[Population, int]:
 def keyed_seeds(n: int) -> np.ndarray:
     """The first ``n`` episode seeds whose first CartCentering noise value exceeds 4/9."""
     seeds = np.arange(200, dtype=np.int64)
-    table = Episodes.grid([resolve("CartCentering")], seeds)
+    table = Episodes.grid([TaskTable.from_names(["CartCentering"]).ids[0]], seeds)
     return seeds[table.noise[:, 0] > 4 / 9 + 1e-3][:n]
 
 
@@ -136,7 +136,8 @@ def test_fresh_noise_keeps_start_states_and_redraws_only_the_noise():
     tasks = ["Pendulum", "CartCentering", "Pendulum[noise=0.1]"]
     seeds = np.array([0, 3, 7], dtype=np.int64)
     fresh = fresh_noise_episodes(tasks, seeds, noise_seed=5, redraws=2)
-    trained = Episodes.grid([resolve(t) for t in tasks], np.tile(seeds, 2))
+    table = TaskTable.from_names(tasks)
+    trained = Episodes.grid(list(table.ids), np.tile(seeds, 2), table)
     assert np.array_equal(fresh.starts, trained.starts)
     assert np.array_equal(fresh.obs_noise, trained.obs_noise)
     assert np.array_equal(fresh.tasks, trained.tasks)

@@ -47,7 +47,8 @@ def late_workload(run_dir: str | Path) -> tuple[Workload, int]:
         raise ValueError(f"{run_dir}: holds no checkpoint")
     ev = config.evaluation
     seeds = resampled_training_seeds(config.seed, 0, ev.train_episodes)
-    pool = Episodes.grid(list(ev.task_ids), seeds)
+    table = ev.task_table()
+    pool = Episodes.grid(list(table.ids), seeds, table)
     cp = compile_population(state.population)
     root_ids = list(state.population.roots())
     n_ep = len(pool.tasks)

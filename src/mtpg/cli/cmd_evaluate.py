@@ -38,12 +38,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.analysis.runs.loading import normalise_scores
-    from mtpg.cli.common import task_list
+    from mtpg.cli.common import target_task_table, task_list
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.protocol import N_TEST_EPISODES
     from mtpg.envs.tasks import MAX_STEPS
-    from mtpg.envs.variants import known, spec_of
+    from mtpg.envs.variants import known
     from mtpg.evolve.testing import evaluate_graph
     from mtpg.limits import check_evaluation_fits
 
@@ -57,15 +57,20 @@ def run(args: argparse.Namespace) -> int:
     unknown = [t for t in tasks if not known(t)]
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
-    longest = max([int(MAX_STEPS.max()), *(spec_of(t).max_steps for t in tasks)])
+    table = target_task_table(Path(args.target), tasks)
+    longest = max([int(MAX_STEPS.max()), *(s.max_steps for s in table.specs)])
     check_evaluation_fits(len(tasks) * args.episodes, longest)
     no_memory, memory = resolve_no_memory(args.memory, meta)
-    scores = evaluate_graph(pop, root, tasks, args.episodes, args.seed, args.workers, no_memory)
+    scores = evaluate_graph(
+        pop, root, tasks, args.episodes, args.seed, args.workers, no_memory, table.given
+    )
     single = single_task_bests(Path(args.target), tasks)
     out = {t: {**s.as_dict(), "no_memory": no_memory, "memory": memory} for t, s in scores.items()}
     for t, best in single.items():
         out[t]["single_task_champion"] = best
-        out[t]["normalised_single_task"] = normalise_scores({t: scores[t].mean}, {t: best})[t]
+        out[t]["normalised_single_task"] = normalise_scores({t: scores[t].mean}, {t: best}, table)[
+            t
+        ]
     if args.json:  # strict JSON: an undefined ratio (best = random) is null
         clean = {
             t: {k: (None if isinstance(v, float) and v != v else v) for k, v in row.items()}

@@ -94,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.main import UsageError
     from mtpg.envs.core import TASK_NAMES
     from mtpg.envs.registry import PAPER_TASKS
-    from mtpg.envs.variants import known, resolve
+    from mtpg.envs.task_table import TaskTable
+    from mtpg.envs.variants import known
     from mtpg.export.common import prepare
     from mtpg.io.serialize import load_graph
 
@@ -130,10 +131,10 @@ def run(args: argparse.Namespace) -> int:
     unknown = [t for t in tasks if not known(t)]
     if unknown:
         raise UsageError(f"unknown task {unknown[0]!r}; choose from {', '.join(TASK_NAMES)}")
-    return _bench(args, graph, pop, root, [resolve(t) for t in tasks])
+    return _bench(args, graph, pop, root, TaskTable.from_names(tasks))
 
 
-def _bench(args, graph, pop, root, task_ids: list[int]) -> int:
+def _bench(args, graph, pop, root, table) -> int:
     from mtpg.cli.main import UsageError
     from mtpg.envs.protocol import held_out_seeds
     from mtpg.export.bench import benchmark
@@ -142,7 +143,7 @@ def _bench(args, graph, pop, root, task_ids: list[int]) -> int:
     if find_compiler() is None:
         raise FileNotFoundError("no C compiler found for --bench (set CC or install cc/gcc)")
     seeds = held_out_seeds(args.bench_episodes)
-    stream = engine_stream(pop, root, task_ids, seeds, no_memory=graph.no_memory)
+    stream = engine_stream(pop, root, list(table.ids), seeds, graph.no_memory, table)
     try:
         res = benchmark(graph, pop, root, stream, runs=args.bench_runs)
     except RuntimeError as exc:

@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from mtpg.analysis.graph.replay import replay_task
-    from mtpg.cli.common import resolve_graph, task_list
+    from mtpg.cli.common import resolve_graph, target_task_table, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
     from mtpg.envs.core import TASK_NAMES
@@ -61,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
         ffmpeg_writer(args.fps)  # fail before the replay when ffmpeg is missing
     pop, root, meta, _ = resolve_graph(Path(args.target))
     no_memory, memory_text = resolve_no_memory(args.memory, meta)
-    replay = replay_task(pop, root, args.task, args.episodes, args.seed, no_memory)
+    table = target_task_table(Path(args.target), [args.task])
+    replay = replay_task(pop, root, args.task, args.episodes, args.seed, no_memory, table=table)
     returns = replay["returns"]
     lengths = np.diff(replay["episode_offsets"])
     print(

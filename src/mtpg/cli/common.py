@@ -92,3 +92,23 @@ def resolve_graph(target: Path):
     from mtpg.envs.registry import PAPER_TASKS
 
     return pop, root, meta, list(meta.get("tasks", PAPER_TASKS))
+
+
+def target_task_table(target: Path, tasks: list[str]):
+    """The task table of ``tasks`` for a graph target (:func:`resolve_graph`).
+
+    A run directory's given reference scores (``evaluation.references``) come with the
+    tasks they name; a graph file's tasks have none.
+
+    Returns:
+        A :class:`mtpg.envs.task_table.TaskTable`.
+    """
+    from mtpg.envs.task_table import TaskTable, parse_given
+
+    references: list[str] = []
+    if target.is_dir():
+        from mtpg.io.runconfig import read_run_config
+
+        given = read_run_config(target).evaluation.references
+        references = [r for r in given if parse_given(r).task in tasks]
+    return TaskTable.from_names(tasks, references)

@@ -15,7 +15,7 @@ from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.kernels import run_jobs_parallel, run_jobs_queue
 from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_parallel, run_lanes_queue
 from mtpg.envs.episodes import draw_episodes
-from mtpg.envs.variants import task_params
+from mtpg.envs.task_table import REGISTERED, TaskTable
 
 
 class Episodes(NamedTuple):
@@ -29,7 +29,7 @@ class Episodes(NamedTuple):
         obs_noise: float64 ``[n, T + 1, 2]``: the observation noise of variants with
             ``noise`` (:func:`mtpg.envs.episodes.draw_episodes`), or ``[n, 0, 2]``.
         params: float64 ``[ids, N_PARAMS]``: the parameter table the task ids index
-            (``mtpg.envs.variants.task_params()`` when the table was drawn).
+            (the ``params`` of the task table the episodes were drawn from).
     """
 
     tasks: np.ndarray
@@ -40,20 +40,26 @@ class Episodes(NamedTuple):
     params: np.ndarray
 
     @classmethod
-    def make(cls, tasks: np.ndarray, seeds: np.ndarray) -> Episodes:
-        """Draws the episodes with the given task ids and seeds (equal lengths)."""
+    def make(cls, tasks: np.ndarray, seeds: np.ndarray, table: TaskTable = REGISTERED) -> Episodes:
+        """Draws the episodes with the given task ids of ``table`` and seeds (equal lengths)."""
         tasks = np.asarray(tasks, dtype=np.int64)
         seeds = np.asarray(seeds, dtype=np.int64)
-        starts, noise, obs_noise = draw_episodes(tasks, seeds)
-        return cls(tasks, seeds, starts, noise, obs_noise, task_params())
+        starts, noise, obs_noise = draw_episodes(tasks, seeds, table)
+        return cls(tasks, seeds, starts, noise, obs_noise, table.params)
 
     @classmethod
     def single(
-        cls, task: int, start: np.ndarray, noise: np.ndarray, obs_noise: np.ndarray | None = None
+        cls,
+        task: int,
+        start: np.ndarray,
+        noise: np.ndarray,
+        obs_noise: np.ndarray | None = None,
+        params: np.ndarray | None = None,
     ) -> Episodes:
         """A table of one given episode: ``task`` from ``start`` with the ``noise`` row.
 
-        ``obs_noise``: the rows ``[T + 1, 2]`` of a variant with observation noise.
+        ``obs_noise``: the rows ``[T + 1, 2]`` of a variant with observation noise;
+        ``params``: the parameter table ``task`` indexes (the registered tasks' by default).
         """
         eps = np.zeros((0, 2)) if obs_noise is None else obs_noise
         return cls(
@@ -62,15 +68,19 @@ class Episodes(NamedTuple):
             np.ascontiguousarray(start, dtype=np.float64).reshape(1, -1),
             np.ascontiguousarray(noise, dtype=np.float64).reshape(1, -1),
             np.ascontiguousarray(eps, dtype=np.float64).reshape(1, -1, 2),
-            task_params(),
+            REGISTERED.params if params is None else params,
         )
 
     @classmethod
-    def grid(cls, tasks: list[int], seeds: list[int] | np.ndarray) -> Episodes:
+    def grid(
+        cls, tasks: list[int], seeds: list[int] | np.ndarray, table: TaskTable = REGISTERED
+    ) -> Episodes:
         """Every task with every seed, task-major: episode ``i * len(seeds) + k``."""
         seeds = np.asarray(seeds, dtype=np.int64)
         return cls.make(
-            np.repeat(np.asarray(tasks, dtype=np.int64), len(seeds)), np.tile(seeds, len(tasks))
+            np.repeat(np.asarray(tasks, dtype=np.int64), len(seeds)),
+            np.tile(seeds, len(tasks)),
+            table,
         )
 
 

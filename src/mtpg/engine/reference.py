@@ -161,6 +161,7 @@ def reference_episode(
     start: np.ndarray,
     noise: np.ndarray,
     obs_noise: np.ndarray | None = None,
+    params: np.ndarray | None = None,
 ) -> tuple[float, int]:
     """Plays one episode with the environment kernels called from Python.
 
@@ -171,28 +172,30 @@ def reference_episode(
         noise: The episode's noise row.
         obs_noise: The episode's observation-noise rows ``[T + 1, 2]`` (a variant with
             ``noise``), or None.
+        params: The parameter table ``task`` indexes (its task table's ``params``; the
+            registered tasks' by default).
 
     Returns:
         ``(return, steps)``.
     """
     from mtpg.envs import env_observe, env_reset, env_step
     from mtpg.envs.core import STATE_SIZE
-    from mtpg.envs.variants import task_params
+    from mtpg.envs.tasks import TASK_PARAMS
 
-    TASK_PARAMS = task_params()  # variants' rows included
+    params = TASK_PARAMS if params is None else params
 
     agent.reset()
     state = np.zeros(STATE_SIZE)
     obs = np.zeros(2)
-    env_reset(task, TASK_PARAMS, start, state)
+    env_reset(task, params, start, state)
     eps = obs_noise if obs_noise is not None and len(obs_noise) else None
-    env_observe(task, TASK_PARAMS, state, noise[0], obs, None if eps is None else eps[0])
+    env_observe(task, params, state, noise[0], obs, None if eps is None else eps[0])
     total, t = 0.0, 0
     while True:
         d = agent.act(obs)
-        reward, terminated, truncated = env_step(task, TASK_PARAMS, state, d.action, d.continuous)
+        reward, terminated, truncated = env_step(task, params, state, d.action, d.continuous)
         total += reward
         t += 1
         if terminated or truncated:
             return total, t
-        env_observe(task, TASK_PARAMS, state, noise[t], obs, None if eps is None else eps[t])
+        env_observe(task, params, state, noise[t], obs, None if eps is None else eps[t])

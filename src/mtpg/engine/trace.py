@@ -159,14 +159,17 @@ def trace_episode(
     no_memory: bool = False,
     snapshot: bool = False,
     obs_noise: np.ndarray | None = None,
+    params: np.ndarray | None = None,
 ) -> Trace:
     """Traces one episode of ``task`` from ``start`` with the episode's ``noise`` row.
 
-    ``obs_noise``: the episode's rows ``[T + 1, 2]``, for a variant with observation noise.
+    ``obs_noise``: the episode's rows ``[T + 1, 2]``, for a variant with observation noise;
+    ``params``: the parameter table ``task`` indexes (its task table's ``params``; the
+    registered tasks' by default).
     """
     _check_unfolded(cp)
     root = cp.team_index(root_id)
-    table = Episodes.single(task, start, noise, obs_noise)
+    table = Episodes.single(task, start, noise, obs_noise, params)
     jobs = Jobs(np.array([root], dtype=np.int64), np.zeros(1, dtype=np.int64))
     out = BatchResult.zeros(1)
 

@@ -14,8 +14,22 @@ from numba import njit
 from mtpg.envs import registry
 from mtpg.envs._util import clip, clip_obs, continuous_action
 
-MAX_STEPS, MAX_TORQUE, DT, LINK_LENGTH_1, LINK_MASS_1, LINK_MASS_2 = range(6)
-LINK_COM_POS_1, LINK_COM_POS_2, LINK_MOI, GRAVITY, MAX_VEL_1, MAX_VEL_2 = range(6, 12)
+# Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
+# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+(
+    MAX_STEPS,
+    MAX_TORQUE,
+    DT,
+    LINK_LENGTH_1,
+    LINK_MASS_1,
+    LINK_MASS_2,
+    LINK_COM_POS_1,
+    LINK_COM_POS_2,
+    LINK_MOI,
+    GRAVITY,
+    MAX_VEL_1,
+    MAX_VEL_2,
+) = range(len(registry.ACROBOT.param_names))
 
 #: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
 PARAMS: tuple[float, ...] = registry.ACROBOT.params

@@ -19,7 +19,19 @@ from mtpg.envs import registry
 from mtpg.envs._util import bang_bang_force, clip, clip_obs
 from mtpg.envs.core import PREV_FORCE_SLOT, STEP_SLOT
 
-MAX_STEPS, FORCE, TAU, MASS, MAX_SPEED, X_BOUND, CAPTURE, START_RANGE, TIME_COST = range(9)
+# Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
+# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+(
+    MAX_STEPS,
+    FORCE,
+    TAU,
+    MASS,
+    MAX_SPEED,
+    X_BOUND,
+    CAPTURE,
+    START_RANGE,
+    TIME_COST,
+) = range(len(registry.CARTCENTERING.param_names))
 
 #: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
 PARAMS: tuple[float, ...] = registry.CARTCENTERING.params

@@ -14,8 +14,19 @@ from mtpg.envs import registry
 from mtpg.envs._util import bang_bang_force, clip_obs
 from mtpg.envs.core import PREV_FORCE_SLOT
 
-# Parameter columns (columns 0 and 1 are common to all tasks, see ``mtpg.envs.tasks``).
-MAX_STEPS, FORCE, TAU, GRAVITY, MASSCART, MASSPOLE, LENGTH, X_THRESHOLD, THETA_THRESHOLD = range(9)
+# Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
+# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+(
+    MAX_STEPS,
+    FORCE,
+    TAU,
+    GRAVITY,
+    MASSCART,
+    MASSPOLE,
+    LENGTH,
+    X_THRESHOLD,
+    THETA_THRESHOLD,
+) = range(len(registry.CARTPOLE.param_names))
 
 #: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
 PARAMS: tuple[float, ...] = registry.CARTPOLE.params

@@ -5,17 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT
-from mtpg.envs.variants import id_ranges, spec_of, valid_id
+from mtpg.envs.task_table import REGISTERED, TaskTable
+from mtpg.envs.variants import obs_noise_sd
 
 
-def _check_task(task: int) -> int:
-    task = int(task)
-    if not valid_id(task):
-        raise ValueError(f"unknown task id {task}; valid ids are {id_ranges()}")
-    return task
-
-
-def sample_start(task: int, rng: np.random.Generator) -> np.ndarray:
+def sample_start(task: int, rng: np.random.Generator, table: TaskTable = REGISTERED) -> np.ndarray:
     """Draws a start state with Gymnasium's reset distribution (CartCentering: Koza's).
 
     The draws are those of the Gymnasium environment's ``reset``, so for the five Gymnasium
@@ -23,15 +17,18 @@ def sample_start(task: int, rng: np.random.Generator) -> np.ndarray:
     ``gymnasium.make(name).reset(seed=s)``. CartCentering redraws a start already captured.
 
     Args:
-        task: The task id.
+        task: The task id in ``table``.
         rng: The episode's generator (advanced by the draws).
+        table: The task table (the registered tasks by default).
 
     Returns:
         A float64 array of ``STATE_SIZE`` slots: the physical state, then the previous force
         (``+F``) and the step count (0).
+
+    Raises:
+        ValueError: For an id the table does not know.
     """
-    task = _check_task(task)
-    spec = spec_of(task)
+    spec = table.spec(int(task))
     phys = np.asarray(spec.kernel("sample_start")(rng), dtype=np.float64)
     start = np.zeros(STATE_SIZE, dtype=np.float64)
     start[: phys.shape[0]] = phys
@@ -40,7 +37,9 @@ def sample_start(task: int, rng: np.random.Generator) -> np.ndarray:
     return start
 
 
-def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def make_episodes(
+    tasks: np.ndarray, seeds: np.ndarray, table: TaskTable = REGISTERED
+) -> tuple[np.ndarray, np.ndarray]:
     """Draws the start states and noise sequences of a batch of episodes.
 
     The start states and U[0, 1] sequences of :func:`draw_episodes` (without the
@@ -52,8 +51,9 @@ def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.
     step ``t``; padding beyond a task's limit is 0.
 
     Args:
-        tasks: int array [n] of task ids.
+        tasks: int array [n] of task ids of ``table``.
         seeds: int array [n] of episode seeds.
+        table: The task table (the registered tasks by default).
 
     Returns:
         (starts float64 [n, STATE_SIZE], noise float64 [n, max(MAX_STEPS[tasks]) + 1]).
@@ -61,12 +61,12 @@ def make_episodes(tasks: np.ndarray, seeds: np.ndarray) -> tuple[np.ndarray, np.
     Raises:
         ValueError: If the arrays differ in length or a task id is unknown.
     """
-    starts, noise, _ = draw_episodes(tasks, seeds)
+    starts, noise, _ = draw_episodes(tasks, seeds, table)
     return starts, noise
 
 
 def draw_episodes(
-    tasks: np.ndarray, seeds: np.ndarray
+    tasks: np.ndarray, seeds: np.ndarray, table: TaskTable = REGISTERED
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Draws the start states, noise sequences and observation noise of a batch of episodes.
 
@@ -83,25 +83,22 @@ def draw_episodes(
     Raises:
         ValueError: If the arrays differ in length or a task id is unknown.
     """
-    from mtpg.envs.variants import obs_noise_sd
-
     tasks = np.asarray(tasks).reshape(-1)
     seeds = np.asarray(seeds).reshape(-1)
     if tasks.shape != seeds.shape:
         raise ValueError(f"tasks and seeds differ in length: {tasks.shape} vs {seeds.shape}")
     n = tasks.shape[0]
-    for task in tasks:
-        _check_task(task)
-    limits = {int(t): spec_of(int(t)).max_steps for t in set(tasks.tolist())}
+    specs = {int(t): table.spec(int(t)) for t in set(tasks.tolist())}
+    limits = {t: spec.max_steps for t, spec in specs.items()}
     width = max(limits.values()) + 1 if n else 1
-    noisy = {t for t in limits if obs_noise_sd(spec_of(t)) > 0.0}
+    noisy = {t for t, spec in specs.items() if obs_noise_sd(spec) > 0.0}
     starts = np.zeros((n, STATE_SIZE), dtype=np.float64)
     noise = np.zeros((n, width), dtype=np.float64)
     obs_noise = np.zeros((n, width if noisy else 0, 2), dtype=np.float64)
     for i in range(n):
-        task = _check_task(tasks[i])
+        task = int(tasks[i])
         rng = np.random.default_rng(int(seeds[i]))
-        starts[i] = sample_start(task, rng)
+        starts[i] = sample_start(task, rng, table)
         k = limits[task] + 1
         noise[i, :k] = rng.random(k)
         if task in noisy:

@@ -25,14 +25,9 @@ from gymnasium import spaces
 from mtpg.envs.core import N_OBS, STATE_SIZE, STEP_SLOT
 from mtpg.envs.episodes import sample_start
 from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.variants import (
-    obs_noise_sd,
-    observation_bounds,
-    resolve,
-    spec_of,
-    task_params,
-    valid_id,
-)
+from mtpg.envs.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskspec import TaskSpec
+from mtpg.envs.variants import obs_noise_sd, observation_bounds
 
 #: The action interfaces: the paper's pair, or the task's own single action.
 ACTIONS: tuple[str, ...] = ("paper", "native")
@@ -51,17 +46,16 @@ def paper_action_space() -> spaces.Tuple:
     return spaces.Tuple((spaces.Discrete(3), spaces.Box(-np.inf, np.inf, (1,), dtype=np.float64)))
 
 
-def native_action_space(task: int) -> spaces.Space:
+def native_action_space(task: TaskSpec) -> spaces.Space:
     """The task's own action: ``Discrete(3)``, or ``Box(-bound, bound, (1,), float64)``."""
-    spec = spec_of(task)
-    if spec.continuous:
-        return spaces.Box(-spec.bound, spec.bound, (1,), dtype=np.float64)
+    if task.continuous:
+        return spaces.Box(-task.bound, task.bound, (1,), dtype=np.float64)
     return spaces.Discrete(3)
 
 
-def native_to_pair(task: int, action: Any) -> tuple[int, float]:
+def native_to_pair(task: TaskSpec, action: Any) -> tuple[int, float]:
     """The paper's ``(a_d, a_c)`` of a native action (the unread one neutral: 1 or 0.0)."""
-    if spec_of(task).continuous:
+    if task.continuous:
         return 1, float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
     return int(np.asarray(action).reshape(-1)[0]), 0.0
 
@@ -85,30 +79,40 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
 
-    def __init__(self, task: int | str, render_mode: str | None = None, action: str = "paper"):
-        task = resolve(task) if isinstance(task, str) else int(task)
-        if not valid_id(task):
+    def __init__(
+        self,
+        task: int | str,
+        render_mode: str | None = None,
+        action: str = "paper",
+        table: TaskTable | None = None,
+    ):
+        if table is None:  # a name is a table of its own; an id is a registered task
+            table = TaskTable.from_names([task]) if isinstance(task, str) else REGISTERED
+        task = table.id_of(task) if isinstance(task, str) else int(task)
+        if not table.valid_id(task):
             raise ValueError(f"unknown task id {task}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"unsupported render_mode {render_mode!r}")
         if action not in ACTIONS:
             raise ValueError(f"action must be one of {', '.join(ACTIONS)}, got {action!r}")
         self._task = int(task)
+        self._table = table
+        self._spec = table.spec(self._task)
         self._native = action == "native"
         self.render_mode = render_mode
-        low, high = observation_bounds(self._task)
+        low, high = observation_bounds(self._spec)
         self.observation_space = spaces.Box(low, high, (N_OBS,), dtype=np.float64)
         self.action_space = (
-            native_action_space(self._task) if self._native else paper_action_space()
+            native_action_space(self._spec) if self._native else paper_action_space()
         )
-        self._params = task_params()
+        self._params = table.params
         self._state = np.zeros(STATE_SIZE, dtype=np.float64)
         self._obs = np.zeros(N_OBS, dtype=np.float64)
-        self._dim = spec_of(self._task).state_dim
-        self._continuous = spec_of(self._task).continuous
+        self._dim = self._spec.state_dim
+        self._continuous = self._spec.continuous
         self._last_action = 0.0
         self._renderer: Any = None
-        self._noisy = obs_noise_sd(spec_of(self._task)) > 0.0
+        self._noisy = obs_noise_sd(self._spec) > 0.0
         self._drawn: tuple[np.ndarray, np.ndarray] | None = None  # (noise, obs_noise)
 
     def _observe(self) -> np.ndarray:
@@ -137,9 +141,9 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
             (observation, info) with ``info["state"]`` the hidden start state.
         """
         super().reset(seed=seed)
-        start = sample_start(self._task, self.np_random)
+        start = sample_start(self._task, self.np_random, self._table)
         if self._noisy:
-            k = spec_of(self._task).max_steps + 1
+            k = self._spec.max_steps + 1
             self._drawn = (self.np_random.random(k), self.np_random.standard_normal((k, 2)))
         env_reset(self._task, self._params, start, self._state)
         self._last_action = 0.0
@@ -156,7 +160,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         Returns:
             (observation, reward, terminated, truncated, info).
         """
-        a_d, a_c = native_to_pair(self._task, action) if self._native else _parse_action(action)
+        a_d, a_c = native_to_pair(self._spec, action) if self._native else _parse_action(action)
         reward, terminated, truncated = env_step(self._task, self._params, self._state, a_d, a_c)
         self._last_action = a_c if self._continuous else 0.0
         return self._observe(), float(reward), bool(terminated), bool(truncated), self._info()
@@ -173,7 +177,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
         if self._renderer is None:
             from mtpg.envs.render import make_renderer
 
-            self._renderer = make_renderer(self._task)
+            self._renderer = make_renderer(self._spec)
         return self._renderer.frame(self._state, self._last_action)
 
     def close(self) -> None:

@@ -12,7 +12,7 @@ or a variant's base task id (:mod:`mtpg.envs.variants`), so a variant runs its b
 kernels on its own parameter row; a row whose ``P_OBS`` column is set is observed by
 :func:`variant_observe`. State lives in a float64 array of ``STATE_SIZE`` slots (see
 ``mtpg.envs.core``); parameters are rows of ``TASK_PARAMS`` (see ``mtpg.envs.tasks``) or of
-``mtpg.envs.variants.task_params()``.
+the ``params`` of a task table (:mod:`mtpg.envs.task_table`).
 
 The dispatch and everything it reaches are compiled without reference counting
 (:data:`step_kernel`): they take arrays and allocate none, while a function compiled with

@@ -18,8 +18,21 @@ from numba import njit
 from mtpg.envs import registry
 from mtpg.envs._util import clip_obs, continuous_action
 
-MAX_STEPS, FORCE, GRAVITY, MIN_POSITION, MAX_POSITION, MAX_SPEED = range(6)
-GOAL_POSITION, GOAL_VELOCITY, GOAL_REWARD, ACTION_COST, POWER = range(6, 11)
+# Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
+# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+(
+    MAX_STEPS,
+    FORCE,
+    GRAVITY,
+    MIN_POSITION,
+    MAX_POSITION,
+    MAX_SPEED,
+    GOAL_POSITION,
+    GOAL_VELOCITY,
+    GOAL_REWARD,
+    ACTION_COST,
+    POWER,
+) = range(len(registry.MOUNTAINCAR.param_names))
 
 #: Parameter row of MountainCar, in column order.
 PARAMS_DISCRETE: tuple[float, ...] = registry.MOUNTAINCAR.params

@@ -14,7 +14,17 @@ from numba import njit
 from mtpg.envs import registry
 from mtpg.envs._util import clip, clip_obs, continuous_action
 
-MAX_STEPS, MAX_TORQUE, DT, GRAVITY, MASS, LENGTH, MAX_SPEED = range(7)
+# Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
+# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+(
+    MAX_STEPS,
+    MAX_TORQUE,
+    DT,
+    GRAVITY,
+    MASS,
+    LENGTH,
+    MAX_SPEED,
+) = range(len(registry.PENDULUM.param_names))
 
 #: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
 PARAMS: tuple[float, ...] = registry.PENDULUM.params

@@ -1,7 +1,7 @@
 """Registers every task of the registry with Gymnasium under the ``mtpg/`` namespace.
 
 Only Gymnasium is imported here; the environment class (and numba) loads when an
-environment is made.
+environment is made. A variant is registered on request (:func:`register`).
 """
 
 from __future__ import annotations
@@ -39,3 +39,19 @@ def register_envs() -> None:
         gymnasium.register(
             id=MULTITASK_ID, entry_point=MULTITASK_ENTRY_POINT, disable_env_checker=False
         )
+
+
+def register(name: str) -> str:
+    """Registers a task or variant with Gymnasium (idempotent); returns its id.
+
+    ``gymnasium.make(register("CartPole[max_steps=500]"), action="native")`` then makes
+    the variant's environment.
+    """
+    import gymnasium
+
+    from mtpg.envs.variants import canonical, gym_id
+
+    env_id = gym_id(name)
+    if env_id not in gymnasium.registry:
+        gymnasium.register(id=env_id, entry_point=ENTRY_POINT, kwargs={"task": canonical(name)})
+    return env_id

@@ -15,23 +15,22 @@ from mtpg.envs._util import clip
 from mtpg.envs.core import CARTCENTERING, PENDULUM
 from mtpg.envs.registry import spec
 from mtpg.envs.tasks import TASK_PARAMS
-from mtpg.envs.variants import spec_of
+from mtpg.envs.taskspec import TaskSpec
 
 
 class GymRenderer:
     """Draws a task with the matching Gymnasium environment's ``render`` by setting its state.
 
     Args:
-        task: The task id (a Gymnasium task).
+        task: The task's spec (a Gymnasium task, or a variant of one).
     """
 
-    def __init__(self, task: int):
+    def __init__(self, task: TaskSpec):
         from gymnasium.envs import classic_control
 
-        self.task = task
-        self.env: Any = getattr(classic_control, spec_of(task).render)(render_mode="rgb_array")
-        self.kind = spec_of(task).base or spec_of(task).name  # a variant draws as its base
-        self.dim = spec_of(task).state_dim
+        self.env: Any = getattr(classic_control, task.render)(render_mode="rgb_array")
+        self.kind = task.base or task.name  # a variant draws as its base
+        self.dim = task.state_dim
 
     def frame(self, state: np.ndarray, last_action: float) -> np.ndarray:
         """Renders one frame.
@@ -112,15 +111,15 @@ class CartCenteringRenderer:
         """Nothing to release (the surface is off-screen)."""
 
 
-def make_renderer(task: int) -> GymRenderer | CartCenteringRenderer:
+def make_renderer(task: TaskSpec) -> GymRenderer | CartCenteringRenderer:
     """Returns the renderer of a task.
 
     Args:
-        task: The task id.
+        task: The task's spec.
 
     Returns:
         An object with ``frame(state, last_action)`` and ``close()``.
     """
-    if spec_of(task).render:
+    if task.render:
         return GymRenderer(task)
-    return globals()[f"{spec_of(task).base or spec_of(task).name}Renderer"]()
+    return globals()[f"{task.base or task.name}Renderer"]()

@@ -120,8 +120,8 @@ def params_table(rows: list[np.ndarray]) -> np.ndarray:
     return table
 
 
-#: float64 [N_TASKS, N_PARAMS]: every task constant (read-only); variants add rows to
-#: ``mtpg.envs.variants.task_params()``.
+#: float64 [N_TASKS, N_PARAMS]: every task constant (read-only); a task table with variants
+#: adds their rows (``mtpg.envs.task_table.TaskTable.params``).
 TASK_PARAMS: np.ndarray = params_table([param_row(t.params, i) for i, t in enumerate(TASKS)])
 
 #: int64 [N_TASKS]: time limits in steps (200, 500, 500, 200, 200, 999).

@@ -153,11 +153,7 @@ class TaskSpec:
     @property
     def gym_id(self) -> str:
         """The Gymnasium id of the paper's two-action interface."""
-        if self.base:
-            from mtpg.envs.variants import gym_id
-
-            return gym_id(self.name)
-        return f"mtpg/{self.name}-v0"
+        return variant_gym_id(self.name) if self.base else f"mtpg/{self.name}-v0"
 
     def kernel(self, role: str) -> Any:
         """The function named by ``step``, ``observe`` or ``sample_start``, imported.
@@ -175,3 +171,17 @@ class TaskSpec:
 
 #: "No threshold" in :class:`Reference`.
 NONE = math.nan
+
+
+def variant_gym_id(name: str) -> str:
+    """The Gymnasium id of a canonically spelled variant, ``Base[k=v;k=v]``.
+
+    ``"CartPole[max_steps=500]"`` gives ``"mtpg/CartPole-max_steps_500-v0"``: the settings
+    in their canonical (sorted) order, ``+`` written ``.``, ``cos(x)`` written ``cos_x``.
+    """
+    base, _, body = name.rstrip("]").partition("[")
+    parts = [
+        item.replace("=", "_", 1).replace("+", ".").replace("(", "_").replace(")", "")
+        for item in body.split(";")
+    ]
+    return f"mtpg/{base}-{'-'.join(parts)}-v0"

@@ -30,11 +30,10 @@ distribution is the base task's (parameters read only by the start sampler, such
 CartCentering's ``start_range``, keep their base value there).
 
 A variant's name is canonical (keys sorted, values normalised): :func:`canonical` turns any
-spelling into it, and the configuration stores it as the task's name. Its id is handed out
-when the name is first resolved in a process (:func:`resolve`), from ``VARIANT_ID_BASE``
-(256) on: ids are process-local; names are what runs, checkpoints and graph files store.
-A variant's reference scores are measured on demand
-(:func:`mtpg.envs.reference.reference_of`).
+spelling into it, and the configuration stores it as the task's name. This module is pure
+functions of names: a variant's id and parameter row belong to the task table it is in
+(:class:`mtpg.envs.task_table.TaskTable`), its reference scores to
+:func:`mtpg.envs.reference.reference_of`.
 """
 
 from __future__ import annotations
@@ -46,19 +45,10 @@ from dataclasses import replace
 import numpy as np
 
 from mtpg.envs.registry import TASK_NAMES, TASKS
-from mtpg.envs.taskspec import NONE, Reference, TaskSpec
+from mtpg.envs.tasks import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP, param_row
+from mtpg.envs.taskspec import NONE, Reference, TaskSpec, variant_gym_id
 
 _NAME = re.compile(r"^(?P<base>[A-Za-z][A-Za-z0-9]*)\[(?P<body>[^\[\]]*)\]$")
-
-#: The first variant id: registered tasks keep 0.., variants get VARIANT_ID_BASE + k, so an
-#: id past the registry stays unknown until a task is registered under it, whatever
-#: variants a process has resolved (rows in between are padding whose kind has no branch).
-VARIANT_ID_BASE = 256
-
-_VARIANTS: list[TaskSpec] = []
-_IDS: dict[str, int] = {name: i for i, name in enumerate(TASK_NAMES)}
-_TABLE: list[np.ndarray] = []
-_CACHE: dict[int, np.ndarray] = {}
 
 
 def is_variant(name: str) -> bool:
@@ -93,8 +83,6 @@ def _observable(base: TaskSpec, name: str) -> bool:
 
 def observe_column(base: TaskSpec, name: str) -> tuple[int, float, float, int]:
     """The ``(slot, low, high, fn)`` input of one observed name (see ``param_row``)."""
-    from mtpg.envs.tasks import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP
-
     m = _FUNCTION.match(name)
     if m is not None:
         fn = OBS_COS if m["fn"] == "cos" else OBS_SIN
@@ -271,14 +259,17 @@ def order_key(name: str) -> tuple[int, int, str]:
 def gym_id(name: str) -> str:
     """The Gymnasium id of a task or variant, e.g. ``mtpg/CartPole-max_steps_500-v0``."""
     name = canonical(name)
+    return variant_gym_id(name) if is_variant(name) else f"mtpg/{name}-v0"
+
+
+def task_spec(name: str) -> TaskSpec:
+    """The spec of a task by name: the registry's, or a variant's (:func:`variant_spec`).
+
+    For a name read back from a file (a replay's task); a run passes its task table.
+    """
     if not is_variant(name):
-        return f"mtpg/{name}-v0"
-    base, settings = parse(name)
-    parts = [
-        f"{k}_{settings[k].replace('+', '.').replace('(', '_').replace(')', '')}"
-        for k in sorted(settings)
-    ]
-    return f"mtpg/{base.name}-{'-'.join(parts)}-v0"
+        return TASKS[TASK_NAMES.index(canonical(name))]
+    return variant_spec(name)
 
 
 def variant_spec(name: str) -> TaskSpec:
@@ -329,9 +320,8 @@ def _ranges(spec: TaskSpec, low: str, high: str) -> tuple[float, float]:
     return _range(settings, low), _range(settings, high)
 
 
-def observation_bounds(task: int | str) -> tuple[np.ndarray, np.ndarray]:
+def observation_bounds(spec: TaskSpec) -> tuple[np.ndarray, np.ndarray]:
     """The low and high bound of each of a task's two inputs (-1, 1 unless a range is set)."""
-    spec = spec_of(task)
     low, high = np.full(2, -1.0), np.full(2, 1.0)
     if spec.base:
         settings = parse(spec.name)[1]
@@ -342,81 +332,14 @@ def observation_bounds(task: int | str) -> tuple[np.ndarray, np.ndarray]:
     return low, high
 
 
-def resolve(name: str) -> int:
-    """The id of a task or variant name (a variant gets the next free id on first use).
-
-    Raises:
-        ValueError: For an unknown task or a bad variant.
-    """
-    if name in _IDS:
-        return _IDS[name]
-    key = canonical(name)
-    if key not in _IDS:
-        from mtpg.envs.tasks import param_row
-
-        spec = variant_spec(key)
-        _VARIANTS.append(spec)
-        _TABLE.append(
-            param_row(
-                spec.params,
-                TASK_NAMES.index(spec.base),
-                _observe_columns(spec),
-                obs_noise_sd(spec),
-                len(spec.observed_slots),
-                _ranges(spec, "obs_low", "obs_high"),
-                _ranges(spec, "noise_low", "noise_high"),
-            )
-        )
-        _IDS[key] = VARIANT_ID_BASE + len(_VARIANTS) - 1
-    _IDS[name] = _IDS[key]
-    return _IDS[key]
-
-
-def register(name: str) -> str:
-    """Registers a task or variant with Gymnasium (idempotent); returns its id.
-
-    ``gymnasium.make(register("CartPole[max_steps=500]"), action="native")`` then makes
-    the variant's environment.
-    """
-    import gymnasium
-
-    from mtpg.envs.registration import ENTRY_POINT
-
-    env_id = gym_id(name)
-    if env_id not in gymnasium.registry:
-        gymnasium.register(id=env_id, entry_point=ENTRY_POINT, kwargs={"task": canonical(name)})
-    return env_id
-
-
-def spec_of(task: int | str) -> TaskSpec:
-    """The spec of a task id or name, registered or variant."""
-    i = resolve(task) if isinstance(task, str) else int(task)
-    if not valid_id(i):
-        raise ValueError(f"unknown task id {i}; valid ids are {id_ranges()}")
-    return TASKS[i] if i < len(TASKS) else _VARIANTS[i - VARIANT_ID_BASE]
-
-
-def valid_id(task: int) -> bool:
-    """Whether an id names a registered task or a variant resolved in this process."""
-    return 0 <= task < len(TASKS) or 0 <= task - VARIANT_ID_BASE < len(_VARIANTS)
-
-
-def id_ranges() -> str:
-    """The valid ids, as text (``0..5`` or ``0..5, 256..257``)."""
-    text = f"0..{len(TASKS) - 1}"
-    if _VARIANTS:
-        text += f", {VARIANT_ID_BASE}..{VARIANT_ID_BASE + len(_VARIANTS) - 1}"
-    return text
-
-
-def task_params() -> np.ndarray:
-    """The parameter table of every id so far: ``TASK_PARAMS`` then one row per variant."""
-    from mtpg.envs.tasks import TASK_PARAMS, param_row, params_table
-
-    if not _VARIANTS:
-        return TASK_PARAMS
-    if len(_VARIANTS) not in _CACHE:
-        _CACHE.clear()
-        padding = [param_row((1.0, 0.0), -1)] * (VARIANT_ID_BASE - len(TASK_PARAMS))
-        _CACHE[len(_VARIANTS)] = params_table([*TASK_PARAMS, *padding, *_TABLE])
-    return _CACHE[len(_VARIANTS)]
+def variant_row(spec: TaskSpec) -> np.ndarray:
+    """The parameter row of a variant's spec (:func:`variant_spec`): its base's kernels."""
+    return param_row(
+        spec.params,
+        TASK_NAMES.index(spec.base),
+        _observe_columns(spec),
+        obs_noise_sd(spec),
+        len(spec.observed_slots),
+        _ranges(spec, "obs_low", "obs_high"),
+        _ranges(spec, "noise_low", "noise_high"),
+    )

@@ -35,8 +35,8 @@ from mtpg.config import RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.envs.protocol import held_out_seeds, resampled_training_seeds
-from mtpg.envs.reference import normalise
-from mtpg.envs.variants import resolve, spec_of
+from mtpg.envs.reference import reference_of
+from mtpg.envs.task_table import TaskTable
 from mtpg.evolve.testing import local_evaluate
 from mtpg.model.graph import Population
 
@@ -51,7 +51,7 @@ SETS = ("train", "fresh_noise", "test")
 
 def observes_noise(task: str) -> bool:
     """Whether a task's second input is the U[0, 1] noise input (one observed variable)."""
-    return len(spec_of(resolve(task)).observed_slots) < 2
+    return len(TaskTable.from_names([task]).specs[0].observed_slots) < 2
 
 
 def training_block(config: RunConfig, generation: int) -> int:
@@ -91,7 +91,11 @@ def champion_training_seeds(config: RunConfig, generation: int) -> np.ndarray:
 
 
 def fresh_noise_episodes(
-    tasks: Sequence[str], seeds: np.ndarray, noise_seed: int, redraws: int
+    tasks: Sequence[str],
+    seeds: np.ndarray,
+    noise_seed: int,
+    redraws: int,
+    table: TaskTable | None = None,
 ) -> Episodes:
     """The episodes ``seeds`` of every task, ``redraws`` times, with the noise row redrawn.
 
@@ -106,6 +110,7 @@ def fresh_noise_episodes(
         seeds: int64 seeds of the episodes whose start states are kept.
         noise_seed: Seed of the redrawn noise (>= 0).
         redraws: Redraws of every episode's noise (>= 1).
+        table: A task table holding ``tasks``; the table of ``tasks`` alone when None.
 
     Returns:
         The episode table, ``len(tasks) * redraws * len(seeds)`` rows.
@@ -118,18 +123,20 @@ def fresh_noise_episodes(
     if redraws < 1:
         raise ValueError(f"redraws must be >= 1, got {redraws}")
     seeds = np.asarray(seeds, dtype=np.int64)
-    table = Episodes.grid([resolve(t) for t in tasks], np.tile(seeds, redraws))
-    noise = np.zeros_like(table.noise)
+    table = TaskTable.from_names(tasks) if table is None else table
+    ids = [table.id_of(t) for t in tasks]
+    grid = Episodes.grid(ids, np.tile(seeds, redraws), table)
+    noise = np.zeros_like(grid.noise)
     row = 0
-    for name in tasks:
-        key = zlib.crc32(spec_of(resolve(name)).name.encode("utf-8"))
-        width = spec_of(resolve(name)).max_steps + 1
+    for spec in (table.spec(i) for i in ids):
+        key = zlib.crc32(spec.name.encode("utf-8"))
+        width = spec.max_steps + 1
         for r in range(redraws):
             for s in seeds.tolist():
                 seq = np.random.SeedSequence(noise_seed, spawn_key=(NOISE_SPAWN_TAG, r, key, s))
                 noise[row, :width] = np.random.default_rng(seq).random(width)
                 row += 1
-    return table._replace(noise=noise)
+    return grid._replace(noise=noise)
 
 
 @dataclass(frozen=True)
@@ -144,6 +151,8 @@ class TaskProbe:
         test: Mean return on (c), the held-out episodes.
         redraw_means: Mean return of each redraw of (b).
         single: The run's single-task champion's test score (NaN: none known).
+        random: The random agent's score of the task (its reference scores).
+        reference_best: The reference best score of the task.
 
     (a), (c) and each redraw's mean are means as the trainer and ``tests.csv`` take them;
     (b) is the exact mean of the redraws' means (:func:`exact_mean`), so a task whose
@@ -157,25 +166,37 @@ class TaskProbe:
     test: float
     redraw_means: tuple[float, ...]
     single: float = float("nan")
+    random: float = float("nan")
+    reference_best: float = float("nan")
 
     def raw(self) -> dict[str, float]:
         """Mean return per set (:data:`SETS`)."""
         return {"train": self.train, "fresh_noise": self.fresh_noise, "test": self.test}
 
+    def normalise(self, score: float, best: float | None = None) -> float:
+        """``(score - random) / (best - random)``, ``best`` the reference best when None.
+
+        Raises:
+            ValueError: If ``best`` equals the random score.
+        """
+        top = self.reference_best if best is None else float(best)
+        span = top - self.random
+        if span == 0:
+            raise ValueError(f"best equals the random score of {self.task}")
+        return (float(score) - self.random) / span
+
     def normalised(self) -> dict[str, float]:
         """Per set: 0 = random play, 1 = reference best."""
-        tid = resolve(self.task)
-        return {k: float(normalise(tid, v)) for k, v in self.raw().items()}
+        return {k: self.normalise(v) for k, v in self.raw().items()}
 
     def vs_single(self) -> dict[str, float]:
         """Per set: 0 = random play, 1 = :attr:`single` (NaN where undefined or unknown)."""
         if self.single != self.single:
             return dict.fromkeys(SETS, float("nan"))
-        tid = resolve(self.task)
         out = {}
         for k, v in self.raw().items():
             try:
-                out[k] = float(normalise(tid, v, self.single))
+                out[k] = self.normalise(v, self.single)
             except ValueError:  # the champion equals random play: undefined
                 out[k] = float("nan")
         return out
@@ -208,6 +229,7 @@ def probe_graph(
     no_memory: bool = False,
     workers: int = 1,
     single: dict[str, float] | None = None,
+    table: TaskTable | None = None,
 ) -> dict[str, TaskProbe]:
     """Plays one graph on (a), (b) and (c) of every task (see the module docstring).
 
@@ -223,19 +245,23 @@ def probe_graph(
         no_memory: Play with the no-memory ablation semantics (as the graph was trained).
         workers: Threads.
         single: The single-task champions' test scores to normalise against, by task.
+        table: A task table holding ``tasks`` (a run's: its given reference scores); the
+            table of ``tasks`` alone when None.
 
     Returns:
         The probe of each task, in the order given.
     """
     tasks = list(tasks)
-    ids = [resolve(t) for t in tasks]
+    if table is None:
+        table = TaskTable.from_names(tasks)
+    ids = [table.id_of(t) for t in tasks]
     train_seeds = np.asarray(train_seeds, dtype=np.int64)
     play = local_evaluate(workers)
     cp = compile_population(pop)
     tables = (
-        Episodes.grid(ids, train_seeds),
-        fresh_noise_episodes(tasks, train_seeds, noise_seed, redraws),
-        Episodes.grid(ids, held_out_seeds(test_episodes, test_offset)),
+        Episodes.grid(ids, train_seeds, table),
+        fresh_noise_episodes(tasks, train_seeds, noise_seed, redraws, table),
+        Episodes.grid(ids, held_out_seeds(test_episodes, test_offset), table),
     )
     train, fresh, test = (
         np.asarray(play(cp, [root], table, no_memory)[0]).reshape(len(tasks), -1)
@@ -251,6 +277,8 @@ def probe_graph(
             float(test[i].mean()),
             tuple(float(row.mean()) for row in per_redraw[i]),
             float((single or {}).get(t, float("nan"))),
+            reference_of(ids[i], table).random,
+            reference_of(ids[i], table).best,
         )
         for i, t in enumerate(tasks)
     }

@@ -20,7 +20,7 @@ from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.envs.protocol import held_out_seeds
 from mtpg.envs.reference import normalise, reference_of
-from mtpg.envs.variants import resolve
+from mtpg.envs.task_table import REGISTERED, GivenReference, TaskTable
 from mtpg.model.graph import Population
 
 #: ``evaluate(compiled, roots, table, no_memory) -> (returns, result)``: how the episodes
@@ -72,24 +72,26 @@ def play_episodes(
     seeds: np.ndarray,
     no_memory: bool = False,
     evaluate: Evaluate | None = None,
+    table: TaskTable = REGISTERED,
 ) -> PlayedEpisodes:
     """Plays every root on the episodes ``seeds`` of every task.
 
     Args:
         pop: The population (or its compiled form) holding the roots.
         roots: Root team ids.
-        task_ids: Task ids.
+        task_ids: Task ids of ``table``.
         seeds: int64 episode seeds, the same for every task.
         no_memory: Play with the no-memory ablation semantics.
         evaluate: How to play (default: one thread of this machine).
+        table: The task table of the ids (the registered tasks by default).
 
     Returns:
         The measurements, ``[roots, tasks, episodes]``.
     """
     cp = pop if isinstance(pop, CompiledPopulation) else compile_population(pop)
     roots, task_ids = list(roots), list(task_ids)
-    table = Episodes.grid(task_ids, seeds)
-    returns, result = (evaluate or local_evaluate())(cp, roots, table, no_memory)
+    grid = Episodes.grid(task_ids, seeds, table)
+    returns, result = (evaluate or local_evaluate())(cp, roots, grid, no_memory)
     shape = (len(roots), len(task_ids), len(seeds))
     return PlayedEpisodes(
         roots,
@@ -108,14 +110,15 @@ def play_test(
     seed: int = 0,
     no_memory: bool = False,
     evaluate: Evaluate | None = None,
+    table: TaskTable = REGISTERED,
 ) -> PlayedEpisodes:
     """The test: :func:`play_episodes` on ``episodes`` held-out episodes of every task.
 
     The seeds are :func:`mtpg.envs.protocol.held_out_seeds` ``(episodes, seed)``: ``seed``
-    is their offset, 0 for a run's own test points.
+    is their offset, 0 for a run's own test points. ``task_ids`` are ids of ``table``.
     """
     seeds = held_out_seeds(episodes, seed)
-    return play_episodes(pop, roots, task_ids, seeds, no_memory, evaluate)
+    return play_episodes(pop, roots, task_ids, seeds, no_memory, evaluate, table)
 
 
 @dataclass(frozen=True)
@@ -130,6 +133,8 @@ class TaskScore:
         normalised: ``(mean - random) / (reference best - random)``.
         teams_per_decision: Mean teams visited per decision.
         returns: The episode returns.
+        random: The random agent's score the normalisation used.
+        reference_best: The reference best score it used.
     """
 
     task: str
@@ -139,6 +144,8 @@ class TaskScore:
     normalised: float
     teams_per_decision: float
     returns: np.ndarray
+    random: float = float("nan")
+    reference_best: float = float("nan")
 
     def as_dict(self) -> dict[str, float | int]:
         """JSON-ready summary (without the returns)."""
@@ -148,8 +155,8 @@ class TaskScore:
             "episodes": self.episodes,
             "normalised": self.normalised,
             "teams_per_decision": self.teams_per_decision,
-            "random": reference_of(self.task).random,
-            "reference_best": reference_of(self.task).best,
+            "random": self.random,
+            "reference_best": self.reference_best,
         }
 
 
@@ -161,6 +168,7 @@ def evaluate_graph(
     seed: int = 0,
     workers: int = 1,
     no_memory: bool = False,
+    references: Sequence[str | GivenReference] = (),
 ) -> dict[str, TaskScore]:
     """Tests one root (:func:`play_test`) and scores it per task, raw and normalised.
 
@@ -172,23 +180,30 @@ def evaluate_graph(
         seed: Offset of the test seeds (see :func:`mtpg.envs.protocol.held_out_seeds`).
         workers: Threads.
         no_memory: Evaluate with the no-memory ablation semantics.
+        references: Reference scores given for variants among ``tasks`` (a run's
+            ``evaluation.references`` entries); the others are normalised as
+            :func:`mtpg.envs.reference.reference_of` says.
 
     Returns:
         Scores by task name, in the order given.
     """
-    ids = [resolve(t) for t in tasks]
-    test = play_test(pop, [root], ids, episodes, seed, no_memory, local_evaluate(workers))
+    table = TaskTable.from_names(tasks, references)
+    ids = list(table.ids)
+    test = play_test(pop, [root], ids, episodes, seed, no_memory, local_evaluate(workers), table)
     returns, steps, teams = test.returns[0], test.steps[0], test.teams[0]
     out = {}
     for k, (name, task) in enumerate(zip(tasks, ids, strict=True)):
         mean = float(returns[k].mean())
+        ref = reference_of(task, table)
         out[name] = TaskScore(
             name,
             mean,
             float(returns[k].std()),
             episodes,
-            float(normalise(task, mean)),
+            float(normalise(task, mean, table=table)),
             float(teams[k].sum() / steps[k].sum()),
             returns[k],
+            ref.random,
+            ref.best,
         )
     return out

@@ -18,7 +18,6 @@ from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.evaluator import Evaluator
 from mtpg.envs.protocol import resampled_training_seeds, validation_seeds
-from mtpg.envs.variants import spec_of
 from mtpg.evolve.backend import make_evaluator
 from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
@@ -141,12 +140,13 @@ class Trainer:
         self.config = config
         self.state = state or TrainerState.new(config)
         ev = config.evaluation
-        self.task_ids = list(ev.task_ids)
+        self.tasks = ev.task_table()  # resolved once: ids, specs, parameter rows
+        self.task_ids = list(self.tasks.ids)
         self.subsets = task_subsets(len(self.task_ids))
         self._block: tuple[int, Episodes] | None = None
         self._extra: dict[str, float] = {}
         self.validation_table = (
-            Episodes.grid(self.task_ids, validation_seeds(ev.validation_episodes))
+            Episodes.grid(self.task_ids, validation_seeds(ev.validation_episodes), self.tasks)
             if ev.validation_episodes > 0
             else None
         )
@@ -167,7 +167,7 @@ class Trainer:
         if self._block is None or self._block[0] != block:
             ev = self.config.evaluation
             seeds = resampled_training_seeds(self.config.seed, block, ev.train_episodes)
-            self._block = (block, Episodes.grid(self.task_ids, seeds))
+            self._block = (block, Episodes.grid(self.task_ids, seeds, self.tasks))
         return self._block[1]
 
     def close(self) -> None:
@@ -181,7 +181,7 @@ class Trainer:
 
     def subset_names(self, k: int) -> tuple[str, ...]:
         """Task names of subset ``k``."""
-        return tuple(spec_of(self.task_ids[i]).name for i in self.subsets[k])
+        return tuple(self.tasks.names[i] for i in self.subsets[k])
 
     def run_generation(self) -> dict[str, float]:
         """Runs one generation and returns its metrics row.
@@ -248,6 +248,7 @@ class Trainer:
             ev.test_episodes,
             no_memory=ev.no_memory,
             evaluate=self.evaluator.evaluate,
+            table=self.tasks,
         )
         means, per_decision = test.mean_returns(), test.teams_per_decision()
         rows = []
@@ -260,8 +261,8 @@ class Trainer:
                 "graph_teams": len(st.population.reachable(root)),
                 "teams_per_decision": float(per_decision[i]),
             }
-            for j, task in enumerate(self.task_ids):
-                row[f"test_{spec_of(task).name}"] = float(means[i, j])
+            for j, name in enumerate(self.tasks.names):
+                row[f"test_{name}"] = float(means[i, j])
             rows.append(row)
         return rows
 
@@ -357,7 +358,7 @@ class Trainer:
             for root, row in zip(todo, means, strict=True):
                 st.validation[root] = row
             decisions = int(result.steps.sum())
-        st.champions = choose(cands, st.validation, self.subsets, self.task_ids)
+        st.champions = choose(cands, st.validation, self.subsets, self.task_ids, self.tasks)
         self._extra.update(validated_roots=len(todo), validation_decisions=decisions)
 
     def _metrics(self, new_roots, result, times) -> dict[str, float]:
@@ -379,9 +380,9 @@ class Trainer:
             "instructions_per_decision": result.instructions.sum() / max(decisions, 1),
             "champion_teams": len(pop.reachable(st.champions[-1])),
         }
-        for k, task in enumerate(self.task_ids):
-            row[f"best_{spec_of(task).name}"] = float(scores[:, k].max())
-            row[f"median_{spec_of(task).name}"] = float(np.median(scores[:, k]))
+        for k, name in enumerate(self.tasks.names):
+            row[f"best_{name}"] = float(scores[:, k].max())
+            row[f"median_{name}"] = float(np.median(scores[:, k]))
         row.update(self._extra)
         t0, t1, t2, t3 = times
         row.update(

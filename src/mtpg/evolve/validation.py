@@ -25,10 +25,14 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.envs.reference import normalise
+from mtpg.envs.task_table import REGISTERED, TaskTable
 
 
 def validation_fitness(
-    scores: np.ndarray, subset: tuple[int, ...], task_ids: list[int]
+    scores: np.ndarray,
+    subset: tuple[int, ...],
+    task_ids: list[int],
+    table: TaskTable = REGISTERED,
 ) -> np.ndarray:
     """Validation fitness of candidates for one subset.
 
@@ -37,12 +41,13 @@ def validation_fitness(
             ``task_ids`` order).
         subset: Column indices of the subset's tasks.
         task_ids: Task id of each column.
+        table: The task table of the ids (their reference scores).
 
     Returns:
         float64 ``[n_candidates]``: the minimum over the subset's tasks of the
         reference-normalised score.
     """
-    norm = np.stack([normalise(task_ids[j], scores[:, j]) for j in subset], axis=1)
+    norm = np.stack([normalise(task_ids[j], scores[:, j], table=table) for j in subset], axis=1)
     return norm.min(axis=1)
 
 
@@ -51,6 +56,7 @@ def choose(
     validation: dict[int, np.ndarray],
     subsets: list[tuple[int, ...]],
     task_ids: list[int],
+    table: TaskTable = REGISTERED,
 ) -> list[int]:
     """Each subset's champion: its candidate of highest validation fitness.
 
@@ -59,6 +65,7 @@ def choose(
         validation: Mean validation score per task of every candidate.
         subsets: Task subsets (column indices), in the order of ``candidates``.
         task_ids: Task id of each score column.
+        table: The task table of the ids.
 
     Returns:
         One team id per subset; ties go to the earlier candidate.
@@ -66,6 +73,6 @@ def choose(
     champions = []
     for cands, subset in zip(candidates, subsets, strict=True):
         scores = np.array([validation[r] for r in cands])
-        fitness = validation_fitness(scores, subset, task_ids)
+        fitness = validation_fitness(scores, subset, task_ids, table)
         champions.append(cands[int(np.argmax(fitness))])  # argmax: first of equals
     return champions

@@ -27,6 +27,7 @@ import numpy as np
 from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_episode
 from mtpg.envs import env_observe
+from mtpg.envs.task_table import REGISTERED, TaskTable
 from mtpg.model.graph import Population
 
 #: Flags of every compilation: C99, warnings as errors, no floating-point contraction.
@@ -154,15 +155,17 @@ def engine_stream(
     tasks: list[int],
     seeds: list[int] | np.ndarray,
     no_memory: bool = False,
+    table: TaskTable = REGISTERED,
 ) -> Stream:
     """Plays every task with every seed in the engine's tracing kernel.
 
     Args:
         pop: The population holding the graph.
         root: Root team id.
-        tasks: Task ids.
+        tasks: Task ids of ``table``.
         seeds: Episode seeds (the same for every task).
         no_memory: Run in no-memory mode.
+        table: The task table of the ids (the registered tasks by default).
 
     Returns:
         The stream, task-major.
@@ -170,13 +173,20 @@ def engine_stream(
     from mtpg.engine.batch import Episodes
 
     cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
-    table = Episodes.grid(list(tasks), list(seeds))
+    table = Episodes.grid(list(tasks), list(seeds), table)
     obs_rows, starts, actions, teams = [], [], [], []
     o = np.zeros(2)
     for e, task in enumerate(table.tasks.tolist()):
         eps = table.obs_noise[e] if table.obs_noise.shape[1] else None
         tr = trace_episode(
-            cp, root, task, table.starts[e], table.noise[e], no_memory=no_memory, obs_noise=eps
+            cp,
+            root,
+            task,
+            table.starts[e],
+            table.noise[e],
+            no_memory=no_memory,
+            obs_noise=eps,
+            params=table.params,
         )
         n = len(tr.actions)
         for t in range(n):

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.analysis.graph.replay import Replay
-from mtpg.envs.variants import spec_of
+from mtpg.envs.variants import task_spec
 
 
 def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
@@ -29,7 +29,7 @@ def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:
         ``continuous`` (bool), ``x_label``, ``y_label``.
     """
     task = replay.task
-    spec = spec_of(task)
+    spec = task_spec(task)
     continuous = spec.continuous
     counts = replay.counts("visit")
     step_of_visit = np.repeat(np.arange(replay.n_steps), counts)

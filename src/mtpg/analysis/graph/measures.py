@@ -10,7 +10,7 @@ import numpy as np
 
 from mtpg.analysis.graph.replay import Replay
 from mtpg.envs.registry import TASKS
-from mtpg.envs.variants import spec_of
+from mtpg.envs.variants import task_spec
 
 #: State slot of the hidden velocity each task's analysis tracks (section 6.3), each spec's
 #: ``velocity_slot``: CartPole the pole's angular velocity, Acrobot the first joint's (the
@@ -203,7 +203,7 @@ def velocity_prediction(replay: Replay, episode: int = 0) -> dict[str, np.ndarra
         raise ValueError(f"episode {episode} has no memory recording in this replay")
     sl = replay.episode_slice(episode)
     task = replay.task
-    velocity = replay["hidden_state"][sl, spec_of(task).velocity_slot]
+    velocity = replay["hidden_state"][sl, task_spec(task).velocity_slot]
     memory = replay["memory"][sl]
     col, r = best_register(velocity, memory)
     m = int(replay["n_memory"])
@@ -214,5 +214,5 @@ def velocity_prediction(replay: Replay, episode: int = 0) -> dict[str, np.ndarra
         "register": scale_pm1(reg) if reg is not None else np.zeros(len(velocity)),
         "r": r,
         "label": f"b{col // m + 1}.m{col % m}" if col >= 0 else "",
-        "variable": spec_of(task).velocity_name,
+        "variable": task_spec(task).velocity_name,
     }

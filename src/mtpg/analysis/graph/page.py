@@ -29,6 +29,7 @@ from mtpg.analysis.runs.hierarchical_complexity import (
     mean_by_size,
     run_complexity,
 )
+from mtpg.envs.task_table import TaskTable
 from mtpg.model.graph import Population
 
 
@@ -118,7 +119,10 @@ class _Analysis:
         self.pop, self.root, self.tasks, self.out = pop, root, tasks, out
         self.episodes, self.seed, self.no_memory, self.label = episodes, seed, no_memory, label
         self.n_teams = len(index_graph(pop, root).teams)
-        self.replays = replay_tasks(pop, root, tasks, episodes, seed, no_memory, memory_episodes=0)
+        self.table = TaskTable.from_names(tasks)  # resolved once, for every replay
+        self.replays = replay_tasks(
+            pop, root, tasks, episodes, seed, no_memory, memory_episodes=0, table=self.table
+        )
         self.visits = visit_statistics(self.replays, self.n_teams)
         self.mem = "memory off" if no_memory else "memory on"
         self.files: dict[str, Path] = {}
@@ -163,7 +167,9 @@ class _Analysis:
     def _task_figure(self, task: str) -> dict[str, object]:
         replays, visits = self.replays, self.visits
         typical = median_episode(replays[task]["returns"])
-        one = replay_task(self.pop, self.root, task, 1, self.seed + typical, self.no_memory)
+        one = replay_task(
+            self.pop, self.root, task, 1, self.seed + typical, self.no_memory, table=self.table
+        )
         pred = velocity_prediction(one, 0)
         name = f"timeseries_{task}.png"
         title = (

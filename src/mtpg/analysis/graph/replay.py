@@ -62,7 +62,8 @@ from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs.episodes import draw_episodes
 from mtpg.envs.protocol import held_out_seeds
-from mtpg.envs.variants import canonical, known, resolve
+from mtpg.envs.task_table import TaskTable
+from mtpg.envs.variants import canonical, known
 from mtpg.model.graph import Population
 
 SCHEMA_VERSION = 1
@@ -160,6 +161,7 @@ def replay_task(
     seed: int = 0,
     no_memory: bool = False,
     memory_episodes: int | None = None,
+    table: TaskTable | None = None,
 ) -> Replay:
     """Plays and traces test episodes of one task.
 
@@ -172,6 +174,8 @@ def replay_task(
         no_memory: Run with memory off (the TPG-NoMemory semantics).
         memory_episodes: Record all memory registers for this many leading episodes
             (None: all; large graphs over many episodes make this array big).
+        table: A task table holding ``task`` (a run's); the table of ``task`` alone when
+            None. The replay's ``task_id`` is the task's id there.
 
     Returns:
         The replay.
@@ -181,10 +185,11 @@ def replay_task(
         raise ValueError(f"write task {task!r} as {canonical(task)!r}")
     if episodes < 1:
         raise ValueError(f"episodes must be >= 1, got {episodes}")
-    task_id = resolve(task)
+    table = TaskTable.from_names([task]) if table is None else table
+    task_id = table.id_of(task)
     cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
     seeds = held_out_seeds(episodes, seed)
-    starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds)
+    starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds, table)
     n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
     traces = [
         trace_episode(
@@ -196,6 +201,7 @@ def replay_task(
             no_memory=no_memory,
             snapshot=e < n_mem_eps,
             obs_noise=obs_noise[e] if obs_noise.shape[1] else None,
+            params=table.params,
         )
         for e in range(episodes)
     ]
@@ -335,6 +341,14 @@ def replay_tasks(
     seed: int = 0,
     no_memory: bool = False,
     memory_episodes: int | None = None,
+    table: TaskTable | None = None,
 ) -> dict[str, Replay]:
-    """:func:`replay_task` for several tasks, by task name in the order given."""
-    return {t: replay_task(pop, root, t, episodes, seed, no_memory, memory_episodes) for t in tasks}
+    """:func:`replay_task` for several tasks, by task name in the order given.
+
+    ``table``: a task table holding the tasks (a run's); the table of ``tasks`` when None.
+    """
+    table = TaskTable.from_names(tasks) if table is None else table
+    return {
+        t: replay_task(pop, root, t, episodes, seed, no_memory, memory_episodes, table)
+        for t in tasks
+    }

@@ -16,6 +16,7 @@ from mtpg.analysis.graph.replay import Replay
 from mtpg.analysis.palette import task_colour
 from mtpg.analysis.plotting import pyplot
 from mtpg.envs.render import make_renderer
+from mtpg.envs.variants import task_spec
 
 #: File endings of the formats written.
 VIDEO_SUFFIXES = (".gif", ".mp4")
@@ -78,7 +79,7 @@ def write_video(
     steps = range(sl.start, sl.stop if max_frames is None else min(sl.stop, sl.start + max_frames))
     # frames are drawn off-screen: no display is needed (and SDL stays quiet without one)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    renderer = make_renderer(int(replay["task_id"]))
+    renderer = make_renderer(task_spec(replay.task))
     task = replay.task
     fig, (ax_task, ax_graph) = plt.subplots(
         1, 2, figsize=(9, 4), gridspec_kw={"width_ratios": [1.3, 1]}

@@ -18,7 +18,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from mtpg.analysis.runs.loading import RunData, load_run
-from mtpg.envs.variants import resolve
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, RunDir, champion_filename
 
@@ -88,7 +87,7 @@ def training_scores(run: RunData, path: Path) -> dict[str, float]:
     ev = run.config.evaluation
     generation = int(meta.get("generation", run.final_generation))
     seeds = champion_training_seeds(run.config, generation)
-    ids = [resolve(t) for t in run.tasks]
-    played = play_episodes(pop, [root], ids, seeds, ev.no_memory)
+    table = run.task_table
+    played = play_episodes(pop, [root], list(table.ids), seeds, ev.no_memory, table=table)
     means = played.returns[0].mean(axis=1)
     return {t: float(m) for t, m in zip(run.tasks, means, strict=True)}

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +26,7 @@ import numpy as np
 from mtpg.ablations import ABLATION_FIELDS, experiment_label
 from mtpg.config import RunConfig, to_dict
 from mtpg.envs.reference import normalise, reference_of
-from mtpg.envs.variants import resolve
+from mtpg.envs.task_table import REGISTERED, TaskTable
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_FILE
 
@@ -58,6 +59,11 @@ class RunData:
     def tasks(self) -> tuple[str, ...]:
         """Active task names."""
         return self.config.evaluation.tasks
+
+    @cached_property
+    def task_table(self) -> TaskTable:
+        """The run's task table: its tasks and their given reference scores."""
+        return self.config.evaluation.task_table()
 
     @property
     def full_set(self) -> str:
@@ -182,17 +188,26 @@ def group_runs(runs: list[RunData]) -> tuple[list[RunGroup], list[str]]:
     return groups, warnings
 
 
-def normalise_scores(scores: dict[str, float], best: dict[str, float]) -> dict[str, float]:
-    """``(score - random) / (best - random)`` per task; NaN when ``best`` equals random."""
+def normalise_scores(
+    scores: dict[str, float], best: dict[str, float], table: TaskTable = REGISTERED
+) -> dict[str, float]:
+    """``(score - random) / (best - random)`` per task; NaN when ``best`` equals random.
+
+    Args:
+        scores: Scores by task name.
+        best: The best score of each task to normalise against.
+        table: The task table of the names (the run's: its given reference scores); the
+            registered tasks by default (a variant's name is refused there).
+    """
     out = {}
     for task, score in scores.items():
         try:
-            out[task] = float(normalise(resolve(task), score, best[task]))
+            out[task] = float(normalise(task, score, best[task], table))
         except ValueError:  # best equals random play: the ratio is undefined
             out[task] = float("nan")
     return out
 
 
-def reference_best(tasks: tuple[str, ...]) -> dict[str, float]:
-    """The reference best score of each task (Fig. 6)."""
-    return {t: reference_of(t).best for t in tasks}
+def reference_best(table: TaskTable) -> dict[str, float]:
+    """The reference best score of each task of a run's table (Fig. 6), by name."""
+    return {t: reference_of(t, table).best for t in table.names}

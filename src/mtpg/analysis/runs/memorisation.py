@@ -166,7 +166,6 @@ def probe_target(
         ValueError: For a task the run did not train on, or a graph without a generation.
     """
     from mtpg.analysis.runs.champions import run_champion, tested_run
-    from mtpg.envs.variants import resolve, spec_of
     from mtpg.io.runconfig import read_run_config
     from mtpg.io.serialize import load_graph
     from mtpg.limits import BudgetError, check_evaluation_fits
@@ -196,7 +195,8 @@ def probe_target(
                 pass
     seeds = champion_training_seeds(config, generation)
     episodes = ev.test_episodes if test_episodes is None else test_episodes
-    longest = max(spec_of(resolve(t)).max_steps for t in chosen)
+    table = ev.task_table()
+    longest = max(table.spec(t).max_steps for t in chosen)
     try:
         check_evaluation_fits(len(chosen) * max(len(seeds) * redraws, episodes), longest)
     except BudgetError as exc:
@@ -213,6 +213,7 @@ def probe_target(
         no_memory=ev.no_memory,
         workers=workers,
         single=single,
+        table=table,
     )
     return Probe(
         target=target,
@@ -328,10 +329,7 @@ def _redraw_scores(p: TaskProbe, pick: str) -> list[float]:
     """Each redraw's mean of (b), raw or normalised."""
     if pick == "raw":
         return list(p.redraw_means)
-    from mtpg.envs.reference import normalise
-    from mtpg.envs.variants import resolve
-
-    return [float(normalise(resolve(p.task), v)) for v in p.redraw_means]
+    return [p.normalise(v) for v in p.redraw_means]
 
 
 def probe_html(named: list[tuple[str, str, Probe]]) -> str:

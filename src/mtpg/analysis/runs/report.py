@@ -124,7 +124,7 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
         f"<h1>mtpg report</h1>{warn_html}\n"
         f"<p>{html.escape(describe([n for _, n in ordered]))} {html.escape(BEST_RUN_RULE)}.</p>\n"
         f"{_runs_list(groups, numbers)}\n"
-        f"{''.join(_tables(groups, ordered, estimates, runs[0].tasks))}\n"
+        f"{''.join(_tables(groups, ordered, estimates, runs[0]))}\n"
         f"{probe_html([(g.label, r.name, probe_target(r.path)) for g in groups for r in g.runs])}\n"
         f"{_improvement_table(pairs)}\n"
         f"{''.join(sections)}"
@@ -224,9 +224,13 @@ def _figures(groups: list[RunGroup], numbers: Numbers, estimates, pairs) -> list
     ]
 
 
-def _tables(groups, ordered: list[tuple[str, RunNumbers]], estimates, tasks) -> list[str]:
-    """The statistics table, then the test, normalised and denominator tables of every run."""
-    ref = reference_best(tasks)
+def _tables(groups, ordered: list[tuple[str, RunNumbers]], estimates, first: RunData) -> list[str]:
+    """The statistics table, then the test, normalised and denominator tables of every run.
+
+    The tasks and reference scores are those of the first run (``first``).
+    """
+    tasks = first.tasks
+    ref = reference_best(first.task_table)
     return [
         _stats_table(groups, estimates, tasks),
         _table(

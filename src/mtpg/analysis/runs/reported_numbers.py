@@ -103,7 +103,8 @@ def run_numbers(run: RunData) -> RunNumbers:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: the champion graph of the final test point is missing")
     train = training_scores(run, path)
-    ref = reference_best(run.tasks)
+    table = run.task_table
+    ref = reference_best(table)
     return RunNumbers(
         run=run,
         generation=gen,
@@ -112,9 +113,9 @@ def run_numbers(run: RunData) -> RunNumbers:
         test=test,
         train=train,
         single=single,
-        normalised=normalise_scores(test, ref),
-        vs_single=normalise_scores(test, single),
-        train_normalised=normalise_scores(train, ref),
+        normalised=normalise_scores(test, ref, table),
+        vs_single=normalise_scores(test, single, table),
+        train_normalised=normalise_scores(train, ref, table),
     )
 
 

@@ -181,7 +181,7 @@ def normalised_vs_reference(group: RunGroup, numbers: Numbers, path: Path) -> Pa
     plt = pyplot()
     best = best_of([numbers[r.path] for r in group.runs])
     tasks = best.run.tasks
-    single = normalise_scores(best.single, reference_best(tasks))
+    single = normalise_scores(best.single, reference_best(best.run.task_table), best.run.task_table)
     fig, ax = plt.subplots(figsize=(7.5, 5))
     _bars(
         ax,
@@ -220,7 +220,7 @@ def ablations(groups: list[RunGroup], numbers: Numbers, path: Path) -> Path:
         best = best_of([numbers[r.path] for r in g.runs])
         shown.append(best)
         bars[f"{g.label} ({best.run.name}, {len(g.runs)} run(s))"] = normalise_scores(
-            best.test, single
+            best.test, single, best.run.task_table
         )
     fig, ax = plt.subplots(figsize=(8.5, 5))
     _bars(ax, tasks, bars)

@@ -35,7 +35,6 @@ from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_episode
 from mtpg.envs.protocol import held_out_seeds
-from mtpg.envs.variants import resolve
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.serialize import load_graph
 
@@ -79,14 +78,16 @@ def scores(run: Path) -> dict[str, float]:
 def off_track(run: Path) -> tuple[float, float]:
     """CartCentering's held-out episodes: the share leaving the track (and of those, from x < 0)."""
     pop, root, _ = load_graph(run_champion(run))
-    tasks = read_run_config(run).evaluation.tasks
-    name = next(t for t in tasks if t.split("[")[0] == "CartCentering")
-    task = resolve(name)
+    tasks = read_run_config(run).evaluation.task_table()
+    name = next(t for t in tasks.names if t.split("[")[0] == "CartCentering")
+    task = tasks.id_of(name)
     cp = compile_population(pop, fold_constants=False)
-    table = Episodes.grid([task], held_out_seeds(EPISODES).tolist())
+    table = Episodes.grid([task], held_out_seeds(EPISODES).tolist(), tasks)
     left, from_left = 0, 0
     for e in range(EPISODES):
-        states = trace_episode(cp, root, task, table.starts[e], table.noise[e]).states
+        states = trace_episode(
+            cp, root, task, table.starts[e], table.noise[e], params=tasks.params
+        ).states
         if abs(states[-1, 0]) > 1.5:
             left += 1
             from_left += int(states[0, 0] < 0)
@@ -128,34 +129,56 @@ def table(results: dict[str, dict[str, dict]]) -> str:
     return "\n".join(lines)
 
 
+#: Each group's colour: the paper's interface blue, the authors' code's orange; CC+MC light.
+COLOURS = {
+    "CC+MC, paper": "#9ecae1",
+    "CC+MC, authors' code": "#fdae6b",
+    "six tasks, paper": "#3182bd",
+    "six tasks, authors' code": "#e6550d",
+}
+
+
 def figure(results: dict[str, dict[str, dict]]) -> None:
-    """Per task IQM over runs (bars) with 95% intervals, each group a colour."""
+    """Per task IQM over runs (bars, 95% intervals), and CartCentering's episodes off track."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(9, 4))
+    fig, (ax, off) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [5, 1.3]})
     order = ["CartPole", "Acrobot", "CartCentering", "Pendulum", "MountainCar"]
     order.append("MountainCarContinuous")
-    groups = [g for g, runs in results.items() if runs]
+    groups = [g for g in GROUPS if results.get(g)]
     width = 0.8 / max(1, len(groups))
     for k, group in enumerate(groups):
-        runs = results[group].values()
-        tasks = [t for t in order if t in next(iter(runs))["scores"]]
+        runs = list(results[group].values())
+        tasks = [t for t in order if t in runs[0]["scores"]]
         m = np.array([[r["scores"][t] for t in tasks] for r in runs])
         est = per_task_iqm(m)
         x = np.array([order.index(t) for t in tasks]) + (k - (len(groups) - 1) / 2) * width
         mid = np.array([e.value for e in est])
         err = np.array([[e.value - e.low for e in est], [e.high - e.value for e in est]])
-        ax.bar(x, mid, width, yerr=err, capsize=2, label=f"{group} ({len(m)} runs)")
+        label = f"{group} ({len(m)} run{'s' if len(m) > 1 else ''})"
+        ax.bar(x, mid, width, yerr=np.nan_to_num(err), capsize=2, label=label, color=COLOURS[group])
+        shares = [100 * r["off_track"] for r in runs]
+        off.bar(k, np.mean(shares), 0.7, color=COLOURS[group])
+        off.plot([k] * len(shares), shares, "k.", ms=4)
     ax.set_xticks(range(len(order)), [t.replace("MountainCar", "MC") for t in order])
     ax.axhline(0, color="grey", lw=0.5)
     ax.set_ylabel("normalised score, IQM over runs")
-    ax.set_title("All-task champions, 100 held-out episodes per task (demo, 1,000 generations)")
+    ax.set_title("All-task champions, 100 held-out episodes per task", fontsize=10)
     ax.legend(fontsize=8, ncol=2)
+    off.set_xticks(range(len(groups)), [g.replace(", ", "\n") for g in groups], fontsize=6)
+    off.set_ylabel("% of episodes (dots: runs)")
+    off.set_ylim(0, 100)
+    off.set_title("CartCentering off the track", fontsize=10)
+    fig.suptitle("The paper's interface and the authors' code's (demo, 1,000 generations)")
     fig.tight_layout()
     save(fig, FIGURE)
 
 
 def main() -> int:
     """Scores the finished runs, rewrites the doc's table and the figure."""
+    stored = FOLDER / "variants.json"
+    if "--figure-only" in sys.argv[1:]:
+        figure(json.loads(stored.read_text()))
+        return 0
     results = collect()
     if not any(results.values()):
         print("no finished run", file=sys.stderr)

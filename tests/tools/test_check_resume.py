@@ -34,7 +34,6 @@ def test_resume_from_an_earlier_commit_is_checked(tmp_path, monkeypatch, capsys)
     _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
     grow = _tool("grow_results")
     monkeypatch.setattr(grow, "PLAN", (("TPG-seed3", 3, None),))
-    monkeypatch.setitem(grow.PLAN_RUNS, "paper", grow.PLAN)  # main() reads the plan there
     argv = ["--budget", "5", "--unchecked", "--results", str(results)]
     argv += [f"--train-arg={a}" for a in SETTINGS]
     assert grow.main([*argv, "--generations", "5"]) == 0  # a commit at generation 5

@@ -37,7 +37,6 @@ def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypa
     monkeypatch.setattr(
         tool, "PLAN", (("TPG-seed3", 3, None), ("TPG-NoMemory-seed3", 3, "no-memory"))
     )
-    monkeypatch.setitem(tool.PLAN_RUNS, "paper", tool.PLAN)  # main() reads the plan there
     monkeypatch.setattr(tool, "KEEP_TESTS_EVERY", 8)
     argv = ["--budget", "5", "--unchecked", "--results", str(repo / "results")]
     argv += [f"--train-arg={a}" for a in SETTINGS]

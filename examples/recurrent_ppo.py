@@ -41,9 +41,9 @@ import gymnasium
 import numpy as np
 
 import mtpg.envs  # noqa: F401  (registers the mtpg/ ids)
-from mtpg.envs.protocol import held_out_seeds
-from mtpg.envs.reference import normalise
-from mtpg.envs.registry import PAPER_TASKS, task_id
+from mtpg.envs.specs.registry import PAPER_TASKS, task_id
+from mtpg.envs.taskset.episode_seeds import held_out_seeds
+from mtpg.envs.taskset.reference_scores import normalise
 
 
 def make_env(env: str, tasks: tuple[str, ...]) -> gymnasium.Env:

@@ -1,9 +1,9 @@
 """Step-by-step outputs of the production decision kernel, for the parity tests.
 
-The tracer (:mod:`mtpg.engine.trace`) runs the production :func:`mtpg.engine.kernels.decide`
-and :func:`mtpg.engine.kernels.play_episode` with a recorder, with the same per-thread
+The tracer (:mod:`mtpg.engine.trace`) runs the production :func:`mtpg.engine.episode_kernels.decide`
+and :func:`mtpg.engine.episode_kernels.play_episode` with a recorder, with the same per-thread
 buffers and the same lazy bank reset; this adapter turns its trace into what the parity
-tests compare with :mod:`mtpg.engine.reference`, decision by decision: the action ``a_d``,
+tests compare with :mod:`mtpg.engine.oracle`, decision by decision: the action ``a_d``,
 the continuous output ``a_c``, the teams visited and every memory bank.
 
 Memory is reported as a program sees it: a bank whose lazy-reset mark is stale (not yet

@@ -225,7 +225,7 @@ def test_constants_the_documents_quote_are_the_code_s():
     """Figures of the code itself, quoted in prose, equal the code's constants."""
     from mtpg.analysis.runs import statistics
     from mtpg.config import build_config
-    from mtpg.envs import protocol
+    from mtpg.envs.taskset import episode_seeds as protocol
     from mtpg.model.instructions import CONSTANTS, OP_NAMES, RegisterLayout
 
     layout = RegisterLayout()

@@ -104,8 +104,10 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 
 def test_the_graph_sees_lazy_and_submodule_imports() -> None:
     graph = import_graph()
-    assert "mtpg.envs.registry" in graph["mtpg.envs.cartpole"]  # from mtpg.envs import registry
-    assert "mtpg.envs.variants" in graph["mtpg.envs.registration"]  # inside a function
+    # from mtpg.envs.specs import registry
+    assert "mtpg.envs.specs.registry" in graph["mtpg.envs.dynamics.cartpole"]
+    # inside a function
+    assert "mtpg.envs.taskset.variants" in graph["mtpg.envs.gym_api.registration"]
     assert cycles({"a": {"b"}, "b": {"a"}, "c": {"a"}}) == [["a", "b"]]
 
 

@@ -179,8 +179,8 @@ def _cost(run_dir: Path) -> tuple[float, float]:
 def _scores(run_dir: Path, generations: int) -> dict[str, list[float]]:
     """Reference-normalised final test scores: ``all`` (full-set champion) and ``single``."""
     from mtpg.analysis.runs.loading import load_run
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.reference import normalise
+    from mtpg.envs.specs.contract import TASK_NAMES
+    from mtpg.envs.taskset.reference_scores import normalise
 
     data = load_run(run_dir)
     if data.final_generation != generations:

@@ -21,9 +21,9 @@ import numpy as np
 
 def oracle(run_dir: Path, episodes: int) -> dict[str, float]:
     """Champion and surviving roots of ``run_dir``'s last checkpoint, tested."""
-    from mtpg.envs.reference import normalise
+    from mtpg.envs.taskset.reference_scores import normalise
+    from mtpg.evolve.heldout_test import play_test
     from mtpg.evolve.persist import state_from_payload
-    from mtpg.evolve.testing import play_test
     from mtpg.io.checkpoint import latest_checkpoint, load_checkpoint
 
     path = latest_checkpoint(run_dir)

@@ -250,7 +250,7 @@ def rescore_rows(runs) -> tuple[list[str], list[list[str]], int, int]:
         within ``sqrt(2)`` half-widths of the test return, and the number of cells.
     """
     from mtpg.analysis.runs.champions import champion_path
-    from mtpg.evolve.testing import evaluate_graph
+    from mtpg.evolve.heldout_test import evaluate_graph
     from mtpg.io.serialize import load_graph
 
     tasks = runs[0].tasks

@@ -34,7 +34,7 @@ from mtpg.analysis.runs.statistics import aggregate_iqm, per_task_iqm
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_episode
-from mtpg.envs.protocol import held_out_seeds
+from mtpg.envs.taskset.episode_seeds import held_out_seeds
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.serialize import load_graph
 

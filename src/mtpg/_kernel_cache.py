@@ -3,7 +3,7 @@
 Numba's cache (``@njit(cache=True)``) checks only the file that defines a kernel: a
 kernel that calls a function of another module keeps the machine code of that function
 as it was compiled, after the other module changed. After a ``git pull`` or a branch
-switch that edits, say, ``envs/kernels.py`` alone, ``engine/kernels.py``'s cached
+switch that edits, say, ``envs/dynamics/dispatch.py`` alone, ``engine/episode_kernels.py``'s cached
 episode loop would still observe the old way: results would silently differ from the
 sources (this happened once while the variant keys were added).
 

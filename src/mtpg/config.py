@@ -18,9 +18,9 @@ from pathlib import Path
 from typing import Any
 
 from mtpg.ablations import ABLATIONS as ABLATIONS  # re-exported: the table lives there
-from mtpg.envs.registry import PAPER_TASKS, TASK_NAMES
-from mtpg.envs.task_table import TaskTable, parse_given
-from mtpg.envs.variants import canonical, from_tables, is_variant
+from mtpg.envs.specs.registry import PAPER_TASKS, TASK_NAMES
+from mtpg.envs.taskset.task_table import TaskTable, parse_given
+from mtpg.envs.taskset.variants import canonical, from_tables, is_variant
 from mtpg.limits import LIMITS
 from mtpg.presets import BACKENDS, PARENT_SELECTIONS, PRESETS
 from mtpg.presets import EXTENSIONS as EXTENSIONS
@@ -153,7 +153,7 @@ class EvaluationConfig:
 
     tasks: tuple[str, ...] = PAPER_TASKS
     """Active tasks, by name: registered names or canonical variants such as
-    ``"CartPole[max_steps=500]"`` (``mtpg.envs.variants``); the power set of these drives
+    ``"CartPole[max_steps=500]"`` (``mtpg.envs.taskset.variants``); the power set of these drives
     selection."""
     train_episodes: int = 5
     """Episodes per task on which each new root is evaluated (seeds 0..n-1)."""
@@ -184,7 +184,7 @@ class EvaluationConfig:
     ``"TASK: best=NUMBER[, random=NUMBER], source=TEXT"`` (``[[task]]`` tables take
     ``reference = {best = ..., source = "..."}``). A variant without one is normalised
     against its base task's best with a measured random score
-    (:func:`mtpg.envs.reference.reference_of`, given the run's
+    (:func:`mtpg.envs.taskset.reference_scores.reference_of`, given the run's
     :meth:`task_table`)."""
 
     def __post_init__(self) -> None:

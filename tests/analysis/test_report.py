@@ -15,9 +15,13 @@ from mtpg.analysis.runs.loading import group_runs, load_run, normalise_scores, r
 from mtpg.analysis.runs.report import MixedRunsWarning, build_report
 from mtpg.analysis.runs.reported_numbers import best_of, best_single_task, run_numbers
 from mtpg.cli.main import main
-from mtpg.envs.core import CARTCENTERING, TASK_NAMES
-from mtpg.envs.reference import REFERENCE, measure_random, measure_time_optimal_cartcentering
-from mtpg.envs.task_table import TaskTable
+from mtpg.envs.specs.contract import CARTCENTERING, TASK_NAMES
+from mtpg.envs.taskset.reference_scores import (
+    REFERENCE,
+    measure_random,
+    measure_time_optimal_cartcentering,
+)
+from mtpg.envs.taskset.task_table import TaskTable
 from mtpg.io.serialize import load_graph
 from tinyruns import tiny_args
 

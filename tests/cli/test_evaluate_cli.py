@@ -1,8 +1,8 @@
 import json
 
 from mtpg.cli.main import main
-from mtpg.envs.protocol import TRAIN_SEED_BASE
-from mtpg.envs.protocol import held_out_seeds as make_test_seeds
+from mtpg.envs.taskset.episode_seeds import TRAIN_SEED_BASE
+from mtpg.envs.taskset.episode_seeds import held_out_seeds as make_test_seeds
 from tinyruns import tiny_args
 
 TINY = tiny_args()

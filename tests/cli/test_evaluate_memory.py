@@ -40,7 +40,7 @@ def no_memory_run(tmp_path_factory):
 
 
 def _reads_memory(run):
-    from mtpg.evolve.testing import evaluate_graph
+    from mtpg.evolve.heldout_test import evaluate_graph
 
     pop, root, _ = load_graph(run / "tests" / "gen-000005" / champion_filename(TASKS))
     off = evaluate_graph(pop, root, list(TASKS), EPISODES, 0, 1, True)

@@ -10,7 +10,7 @@ import pytest
 
 from mtpg.analysis.runs.loading import load_run
 from mtpg.cli.main import main
-from mtpg.envs.protocol import resampled_training_seeds
+from mtpg.envs.taskset.episode_seeds import resampled_training_seeds
 from tinyruns import tiny_args
 
 TASKS = ["CartPole", "CartCentering"]

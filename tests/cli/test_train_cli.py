@@ -158,7 +158,7 @@ def test_test_points_follow_the_interval(tmp_path):
         names = sorted(p.name for p in (out / "tests" / gen).glob("*.json"))
         assert names == ["CartPole+MountainCar.json", "CartPole.json", "MountainCar.json"]
     # the stored test score is the champion's mean over the held-out episodes
-    from mtpg.evolve.testing import evaluate_graph
+    from mtpg.evolve.heldout_test import evaluate_graph
     from mtpg.io.serialize import load_graph
 
     pop, root, meta = load_graph(out / "tests" / "gen-000004" / "CartPole.json")

@@ -13,7 +13,7 @@ from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.dask_backend import DaskEvaluator, plan_batches
 from mtpg.engine.workload import tangled_population
-from mtpg.envs.task_table import TaskTable
+from mtpg.envs.taskset.task_table import TaskTable
 from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
 
 TINY = [

@@ -14,11 +14,11 @@ from graph_strategies import tangled_cases
 from mtpg.config import build_config
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
-from mtpg.engine.reference import ReferenceAgent
+from mtpg.engine.oracle import ReferenceAgent
 from mtpg.engine.workload import layered_graphs
 from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
-from mtpg.envs.core import STATE_SIZE, TASK_NAMES
-from mtpg.envs.protocol import held_out_seeds
+from mtpg.envs.specs.contract import STATE_SIZE, TASK_NAMES
+from mtpg.envs.taskset.episode_seeds import held_out_seeds
 from mtpg.evolve.trainer import Trainer
 from mtpg.model.graph import check_invariants
 from mtpg.model.instructions import RegisterLayout

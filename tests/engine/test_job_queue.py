@@ -1,7 +1,7 @@
 """The batch kernel's job queue: every block taken exactly once, by any number of workers.
 
 Workers take blocks of jobs from a shared int64 counter with an atomic fetch-and-add
-(:func:`mtpg.engine.kernels.run_jobs_queue`). Duplicated work would not show in the
+(:func:`mtpg.engine.episode_kernels.run_jobs_queue`). Duplicated work would not show in the
 outputs (a job played twice writes the same values twice), so these tests read the
 counter itself: with an atomic add it ends at exactly ``blocks + workers``; a lost update
 between racing workers would leave it lower.
@@ -14,10 +14,10 @@ import numpy as np
 
 from mtpg.engine.batch import BatchResult, Episodes, Jobs, run_jobs
 from mtpg.engine.compile import compile_population
-from mtpg.engine.kernels import _fetch_add, run_jobs_parallel, run_jobs_queue
+from mtpg.engine.episode_kernels import _fetch_add, run_jobs_parallel, run_jobs_queue
 from mtpg.engine.workload import layered_graphs
 from mtpg.envs import TASK_PARAMS
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.specs.contract import TASK_NAMES
 
 
 def _setup(n_graphs=60, seeds=(0, 1, 2)):

@@ -1,8 +1,8 @@
 """The per-step dispatch compiles without reference counting (docs/engine.md).
 
-The batch kernel calls :func:`~mtpg.envs.kernels.task_step` and
-:func:`~mtpg.envs.kernels.task_observe` once per step, passing the state, the parameter row
-and the observation. Compiled with Numba's reference counting, each call would pay an
+The batch kernel calls :func:`~mtpg.envs.dynamics.dispatch.task_step` and
+:func:`~mtpg.envs.dynamics.dispatch.task_observe` once per step, passing the state, the parameter
+row and the observation. Compiled with Numba's reference counting, each call would pay an
 atomic increment and decrement per array (about ten per step); compiled as step kernels,
 their machine code, with the task functions inlined into it, calls neither.
 
@@ -21,8 +21,8 @@ SCRIPT = """
 import json
 import numpy as np
 from mtpg.envs import TASK_PARAMS
-from mtpg.envs.core import STATE_SIZE
-from mtpg.envs.kernels import add_obs_noise, task_observe, task_step
+from mtpg.envs.specs.contract import STATE_SIZE
+from mtpg.envs.dynamics.dispatch import add_obs_noise, task_observe, task_step
 p = TASK_PARAMS[0].copy()
 p.flags.writeable = False  # the batch kernel's parameter table is read-only
 state, obs = np.zeros(STATE_SIZE), np.zeros(2)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from mtpg.engine.ops import apply_op
-from mtpg.engine.reference import reference_op
+from mtpg.engine.oracle import reference_op
 from mtpg.model.instructions import BIG, N_OPS
 
 EXTREMES = [

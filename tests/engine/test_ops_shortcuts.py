@@ -17,7 +17,7 @@ import pytest
 
 from mtpg.engine.lane_ops import lane_op
 from mtpg.engine.ops import OP_COPY, POW_SAFE_HI, POW_SAFE_LO, apply_op
-from mtpg.engine.reference import reference_op
+from mtpg.engine.oracle import reference_op
 from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, N_OPS
 
 

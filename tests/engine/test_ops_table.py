@@ -16,7 +16,7 @@ import math
 import pytest
 
 from mtpg.engine.ops import apply_op
-from mtpg.engine.reference import reference_op
+from mtpg.engine.oracle import reference_op
 
 OPS = {
     name: k

@@ -90,7 +90,7 @@ def test_a_run_whose_logs_overflow_is_played_again_with_room_for_all(monkeypatch
 
 def test_a_traced_episode_ends_where_its_noise_row_ends():
     from mtpg.engine.workload import layered_graphs
-    from mtpg.envs.core import ACROBOT
+    from mtpg.envs.specs.contract import ACROBOT
 
     pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=2, programs=4, instructions=4)
     cp = compile_population(pop, fold_constants=False)

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from mtpg.envs import CARTCENTERING, STATE_SIZE, TASK_PARAMS, env_reset, env_step, sample_start
-from mtpg.envs.cartcentering import is_captured
-from mtpg.envs.episodes import make_episodes
-from mtpg.envs.rollout import run_time_optimal
+from mtpg.envs.dynamics.cartcentering import is_captured
+from mtpg.envs.dynamics.rollout import run_time_optimal
+from mtpg.envs.taskset.episodes import make_episodes
 
 TAU = 0.02
 MASS = 2.0

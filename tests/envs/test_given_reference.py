@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from mtpg.config import ConfigError, build_config, from_dict, to_dict, to_toml
-from mtpg.envs.reference import normalise, reference_of
-from mtpg.envs.task_table import GivenReference, TaskTable, parse_given
+from mtpg.envs.taskset.reference_scores import normalise, reference_of
+from mtpg.envs.taskset.task_table import GivenReference, TaskTable, parse_given
 from mtpg.evolve.persist import identity_fields, run_identity
 
 

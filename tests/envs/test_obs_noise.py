@@ -11,10 +11,10 @@ from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe, env_reset, sample_start
-from mtpg.envs.episodes import draw_episodes, make_episodes
-from mtpg.envs.registration import register
-from mtpg.envs.task_table import TaskTable
-from mtpg.envs.variants import canonical, obs_noise_sd, task_spec
+from mtpg.envs.gym_api.registration import register
+from mtpg.envs.taskset.episodes import draw_episodes, make_episodes
+from mtpg.envs.taskset.task_table import TaskTable
+from mtpg.envs.taskset.variants import canonical, obs_noise_sd, task_spec
 
 NOISY = "Pendulum[noise=0.25;observe=theta]"
 

@@ -44,7 +44,7 @@ from mtpg.envs import (
     MtpgEnv,
     make_episodes,
 )
-from mtpg.envs._util import clip_obs
+from mtpg.envs.dynamics.numeric import clip_obs
 from mtpg.model.graph import Population, atomic
 from mtpg.model.instructions import RegisterLayout
 

@@ -14,7 +14,7 @@ import inspect
 
 import pytest
 
-from mtpg.envs.registry import TASKS
+from mtpg.envs.specs.registry import TASKS
 
 
 def written_columns(module) -> list[str]:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mtpg.envs import CARTCENTERING, TASK_NAMES
-from mtpg.envs.reference import (
+from mtpg.envs.taskset.reference_scores import (
     REFERENCE,
     make_test_seeds,
     measure_random,

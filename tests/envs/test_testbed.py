@@ -9,9 +9,9 @@ from gymnasium import spaces
 from gymnasium.utils.env_checker import check_env
 
 from mtpg.envs import make_episodes
-from mtpg.envs.multitask import MultiTaskEnv, box_to_pair
-from mtpg.envs.registration import MULTITASK_ID
-from mtpg.envs.registry import PAPER_TASKS, TASKS
+from mtpg.envs.gym_api.multitask import MultiTaskEnv, box_to_pair
+from mtpg.envs.gym_api.registration import MULTITASK_ID
+from mtpg.envs.specs.registry import PAPER_TASKS, TASKS
 
 
 @pytest.mark.filterwarnings("ignore:.*Box action space.*:UserWarning")  # Pendulum's [-2, 2]

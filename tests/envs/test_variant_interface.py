@@ -16,12 +16,12 @@ from gymnasium.utils.env_checker import check_env
 
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
-from mtpg.engine.reference import ReferenceAgent, reference_episode
+from mtpg.engine.oracle import ReferenceAgent, reference_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe
-from mtpg.envs.registration import register
-from mtpg.envs.task_table import TaskTable
-from mtpg.envs.variants import canonical, observation_bounds, task_spec
+from mtpg.envs.gym_api.registration import register
+from mtpg.envs.taskset.task_table import TaskTable
+from mtpg.envs.taskset.variants import canonical, observation_bounds, task_spec
 
 MC = "MountainCar[noise_high=pi;noise_low=-pi;obs_high=1;obs_low=0]"
 CC = "CartCentering[noise_high=1;noise_low=-1]"

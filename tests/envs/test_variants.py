@@ -9,14 +9,14 @@ from gymnasium.utils.env_checker import check_env
 
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
-from mtpg.engine.reference import ReferenceAgent, reference_episode
+from mtpg.engine.oracle import ReferenceAgent, reference_episode
 from mtpg.engine.trace import trace_episode
 from mtpg.engine.workload import tangled_population
 from mtpg.envs import PREV_FORCE_SLOT, env_observe, env_reset, env_step
-from mtpg.envs.core import CARTPOLE
-from mtpg.envs.registration import register
-from mtpg.envs.task_table import VARIANT_ID_BASE, TaskTable
-from mtpg.envs.variants import canonical, gym_id
+from mtpg.envs.gym_api.registration import register
+from mtpg.envs.specs.contract import CARTPOLE
+from mtpg.envs.taskset.task_table import VARIANT_ID_BASE, TaskTable
+from mtpg.envs.taskset.variants import canonical, gym_id
 
 CP500 = "CartPole[max_steps=500]"
 

@@ -12,15 +12,15 @@ import numpy as np
 import pytest
 
 from mtpg.config import ConfigError, RunConfig, build_config, from_dict, to_dict, to_toml
-from mtpg.envs.protocol import (
+from mtpg.envs.taskset.episode_seeds import (
     TEST_SEED_BASE,
     held_out_seeds,
     resampled_training_seeds,
     training_seeds,
     validation_seeds,
 )
-from mtpg.envs.reference import REFERENCE
-from mtpg.evolve import testing as testing_module
+from mtpg.envs.taskset.reference_scores import REFERENCE
+from mtpg.evolve import heldout_test as heldout_test_module
 from mtpg.evolve import trainer as trainer_module
 from mtpg.evolve.persist import (
     config_differences,
@@ -231,7 +231,7 @@ def test_test_episodes_never_reach_selection_or_the_champion_choice(monkeypatch,
             assert not any(TEST_SEED_BASE <= s < TEST_SEED_BASE + 1_000_000 for s in seeds)
     # other test episodes (other outcomes): the same run, other test rows
     other = held_out_seeds(3, offset=500)
-    monkeypatch.setattr(testing_module, "held_out_seeds", lambda n, offset=0: other)
+    monkeypatch.setattr(heldout_test_module, "held_out_seeds", lambda n, offset=0: other)
     moved, rows2, tests2 = _run(config, 5)
     assert _state(moved) == _state(ref)
     assert [r["root"] for t in tests2 for r in t] == [r["root"] for t in tests for r in t]

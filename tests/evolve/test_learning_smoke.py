@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from mtpg.config import build_config
 from mtpg.envs import CARTPOLE
-from mtpg.envs.reference import REFERENCE
+from mtpg.envs.taskset.reference_scores import REFERENCE
 from mtpg.evolve.trainer import Trainer
 
 MARGIN = 15.0

@@ -14,7 +14,7 @@ import pytest
 
 from mtpg.config import build_config
 from mtpg.engine.batch import Episodes
-from mtpg.envs.task_table import TaskTable
+from mtpg.envs.taskset.task_table import TaskTable
 from mtpg.evolve.memorisation import (
     champion_training_seeds,
     fresh_noise_episodes,

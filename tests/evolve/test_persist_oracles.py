@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from mtpg.config import build_config
-from mtpg.envs.core import N_OBS
+from mtpg.envs.specs.contract import N_OBS
 from mtpg.evolve.persist import run_identity, state_from_payload, state_to_payload
 from mtpg.evolve.session import Session, load_state
 from mtpg.evolve.trainer import Trainer

@@ -10,7 +10,7 @@ import pytest
 
 from mtpg.config import ConfigError, build_config
 from mtpg.engine import evaluator as evaluator_module
-from mtpg.envs.protocol import held_out_seeds
+from mtpg.envs.taskset.episode_seeds import held_out_seeds
 from mtpg.evolve.persist import state_from_payload, state_to_payload
 from mtpg.evolve.session import Session, read_run_config
 from mtpg.evolve.trainer import Trainer

@@ -5,7 +5,7 @@ import itertools
 
 import pytest
 
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.export.c import write_c
 from mtpg.export.common import prepare
 from mtpg.export.harness import build_driver, compile_driver, find_compiler, run_check

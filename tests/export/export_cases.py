@@ -9,7 +9,7 @@ import numpy as np
 from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_sequence
 from mtpg.engine.workload import layered_graphs, tangled_population
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.export.harness import Stream, mismatches
 from mtpg.model.graph import Population, atomic
 from mtpg.model.instructions import OP_ADD, OP_MUL, RegisterLayout

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from mtpg.cli.main import main
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.io.rundir import champion_filename
 from mtpg.io.serialize import load_graph, save_graph
 

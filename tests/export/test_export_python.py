@@ -18,7 +18,7 @@ from export_cases import (
     sequence_stream,
 )
 
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.export.common import prepare
 from mtpg.export.harness import Stream, engine_stream
 from mtpg.export.python import module_text, write_python

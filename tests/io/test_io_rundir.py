@@ -5,7 +5,7 @@ import csv
 import numpy as np
 import pytest
 
-from mtpg.engine.reference import ReferenceAgent
+from mtpg.engine.oracle import ReferenceAgent
 from mtpg.engine.workload import layered_graphs
 from mtpg.io import (
     MetricsWriter,

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from mtpg.engine.reference import ReferenceAgent
+from mtpg.engine.oracle import ReferenceAgent
 from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.io import (
     FormatError,

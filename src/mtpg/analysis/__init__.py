@@ -10,5 +10,5 @@
 - Shared: :mod:`mtpg.analysis.html` (pages), :mod:`mtpg.analysis.plotting` (matplotlib),
   :mod:`mtpg.analysis.palette` (colours).
 
-The test protocol every score comes from is :mod:`mtpg.evolve.testing`.
+The test protocol every score comes from is :mod:`mtpg.evolve.heldout_test`.
 """

@@ -6,8 +6,8 @@ videos); the section-5 figures of :mod:`mtpg.analysis.runs.score_figures` colour
 
 from __future__ import annotations
 
-from mtpg.envs.core import TASK_NAMES
-from mtpg.envs.registry import TASKS
+from mtpg.envs.specs.contract import TASK_NAMES
+from mtpg.envs.specs.registry import TASKS
 
 #: One colour per task, each spec's ``colour`` (the six are matplotlib's colour-blind-safe
 #: "tab10" picks).

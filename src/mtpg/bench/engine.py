@@ -25,7 +25,7 @@ import numpy as np
 from mtpg.bench.workload import Workload, drive, make_workload, warm_up
 from mtpg.engine.batch import BatchResult
 from mtpg.engine.lanes import DEFAULT_LANES
-from mtpg.engine.reference import ReferenceAgent, reference_episode
+from mtpg.engine.oracle import ReferenceAgent, reference_episode
 from mtpg.envs import CARTPOLE
 from mtpg.model.graph import Population
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
@@ -72,7 +72,7 @@ def run_reference(work: Workload, graphs: int) -> ReferenceRun:
     """Plays the jobs of the first ``graphs`` graphs with the reference interpreter.
 
     The episodes are those of the same jobs in the workload, played by
-    :func:`~mtpg.engine.reference.reference_episode`; only the calls to ``act`` are timed.
+    :func:`~mtpg.engine.oracle.reference_episode`; only the calls to ``act`` are timed.
 
     Args:
         work: The workload.

@@ -1,6 +1,6 @@
 /* The engine benchmark's workload in hand-written C: the yardstick of `mtpg bench engine --c`.
  *
- * The same work as mtpg.engine.kernels.run_jobs_queue on one thread: every job (graph x
+ * The same work as mtpg.engine.episode_kernels.run_jobs_queue on one thread: every job (graph x
  * CartPole episode) resets the task, then decides and steps until the episode ends; a
  * decision traverses the graph from the job's root, running each visited team's programs
  * on a workspace of private registers, constants, the observation and the memory banks,
@@ -30,7 +30,7 @@
 
 enum { N_HEADER = 13, STATE_SIZE = 6, PREV_FORCE = 4, STEP = 5 };
 
-/* CartPole parameter columns (mtpg.envs.cartpole). */
+/* CartPole parameter columns (mtpg.envs.dynamics.cartpole). */
 enum { MAX_STEPS, FORCE, TAU, GRAVITY, MASSCART, MASSPOLE, LENGTH, X_THRESHOLD, THETA_THRESHOLD };
 
 #if !defined(MTPG_BIG) || !defined(MTPG_DIV_EPS) || !defined(MTPG_LOG_BIG) || !defined(MTPG_LOG_TINY)
@@ -144,7 +144,7 @@ static double clip_obs(double x)
     return x < -1.0 ? -1.0 : (x > 1.0 ? 1.0 : x);
 }
 
-/* CartPole's step (mtpg.envs.cartpole.step, Gymnasium's operation order). */
+/* CartPole's step (mtpg.envs.dynamics.cartpole.step, Gymnasium's operation order). */
 static int cartpole_step(const double *p, double *s, int a_d)
 {
     double force = a_d == 0 ? p[FORCE] : (a_d == 2 ? -p[FORCE] : s[PREV_FORCE]);

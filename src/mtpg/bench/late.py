@@ -37,7 +37,7 @@ def late_workload(run_dir: str | Path) -> tuple[Workload, int]:
     Raises:
         ValueError: The directory holds no checkpoint.
     """
-    from mtpg.envs.protocol import resampled_training_seeds
+    from mtpg.envs.taskset.episode_seeds import resampled_training_seeds
     from mtpg.evolve.session import load_state, read_run_config
 
     t0 = time.perf_counter()

@@ -41,8 +41,8 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.common import resolve_graph, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.variants import known
+    from mtpg.envs.specs.contract import TASK_NAMES
+    from mtpg.envs.taskset.variants import known
 
     if args.episodes < 1:
         raise UsageError(f"--episodes must be >= 1, got {args.episodes}")

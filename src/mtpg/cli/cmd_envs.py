@@ -44,13 +44,13 @@ def run(args: argparse.Namespace) -> int:
     Returns:
         Exit code 0.
     """
-    from mtpg.envs.core import CARTCENTERING, TASK_NAMES
-    from mtpg.envs.reference import (
+    from mtpg.envs.specs.contract import CARTCENTERING, TASK_NAMES
+    from mtpg.envs.specs.param_table import ACTION_USED, MAX_STEPS, OBSERVED
+    from mtpg.envs.taskset.reference_scores import (
         REFERENCE,
         measure_random,
         measure_time_optimal_cartcentering,
     )
-    from mtpg.envs.tasks import ACTION_USED, MAX_STEPS, OBSERVED
 
     header = (
         "id",

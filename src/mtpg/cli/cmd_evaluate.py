@@ -40,11 +40,11 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.analysis.runs.loading import normalise_scores
     from mtpg.cli.common import target_task_table, task_list
     from mtpg.cli.main import UsageError
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.protocol import N_TEST_EPISODES
-    from mtpg.envs.tasks import MAX_STEPS
-    from mtpg.envs.variants import known
-    from mtpg.evolve.testing import evaluate_graph
+    from mtpg.envs.specs.contract import TASK_NAMES
+    from mtpg.envs.specs.param_table import MAX_STEPS
+    from mtpg.envs.taskset.episode_seeds import N_TEST_EPISODES
+    from mtpg.envs.taskset.variants import known
+    from mtpg.evolve.heldout_test import evaluate_graph
     from mtpg.limits import check_evaluation_fits
 
     pop, root, meta, tasks = resolve_graph(Path(args.target))
@@ -78,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
         }
         print(json.dumps(clean, allow_nan=False))
         return 0
-    from mtpg.envs.protocol import describe_held_out
+    from mtpg.envs.taskset.episode_seeds import describe_held_out
 
     where = (
         f"all-task champion at generation {meta['generation']} (best root by training score)"

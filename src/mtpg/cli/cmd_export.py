@@ -92,10 +92,10 @@ def run(args: argparse.Namespace) -> int:
     """Runs the command."""
     from mtpg.cli.common import task_list
     from mtpg.cli.main import UsageError
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.registry import PAPER_TASKS
-    from mtpg.envs.task_table import TaskTable
-    from mtpg.envs.variants import known
+    from mtpg.envs.specs.contract import TASK_NAMES
+    from mtpg.envs.specs.registry import PAPER_TASKS
+    from mtpg.envs.taskset.task_table import TaskTable
+    from mtpg.envs.taskset.variants import known
     from mtpg.export.common import prepare
     from mtpg.io.serialize import load_graph
 
@@ -136,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _bench(args, graph, pop, root, table) -> int:
     from mtpg.cli.main import UsageError
-    from mtpg.envs.protocol import held_out_seeds
+    from mtpg.envs.taskset.episode_seeds import held_out_seeds
     from mtpg.export.bench import benchmark
     from mtpg.export.harness import engine_stream, find_compiler
 

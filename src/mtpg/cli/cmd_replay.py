@@ -43,8 +43,8 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.common import resolve_graph, target_task_table, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.variants import known
+    from mtpg.envs.specs.contract import TASK_NAMES
+    from mtpg.envs.taskset.variants import known
 
     [args.task] = task_list(args.task, "--task")  # a variant checked, spelled canonically
     if not known(args.task):

@@ -27,11 +27,11 @@ def task_list(text: str, option: str = "--tasks") -> list[str]:
     """The canonical names of a comma-separated list option, refusing an empty one.
 
     Commas inside a variant's brackets do not split (``CartPole[max_steps=500],Pendulum``);
-    each name is checked and spelled canonically (``mtpg.envs.variants.canonical``).
+    each name is checked and spelled canonically (``mtpg.envs.taskset.variants.canonical``).
     """
     from mtpg.cli.main import UsageError
-    from mtpg.envs.core import TASK_NAMES
-    from mtpg.envs.variants import canonical, is_variant
+    from mtpg.envs.specs.contract import TASK_NAMES
+    from mtpg.envs.taskset.variants import canonical, is_variant
 
     parts, depth, word = [], 0, ""
     for ch in text:
@@ -89,7 +89,7 @@ def resolve_graph(target: Path):
         meta.setdefault("test_episodes", config.evaluation.test_episodes)
         return pop, root, meta, list(config.evaluation.tasks)
     pop, root, meta = load_graph(target)
-    from mtpg.envs.registry import PAPER_TASKS
+    from mtpg.envs.specs.registry import PAPER_TASKS
 
     return pop, root, meta, list(meta.get("tasks", PAPER_TASKS))
 
@@ -101,9 +101,9 @@ def target_task_table(target: Path, tasks: list[str]):
     tasks they name; a graph file's tasks have none.
 
     Returns:
-        A :class:`mtpg.envs.task_table.TaskTable`.
+        A :class:`mtpg.envs.taskset.task_table.TaskTable`.
     """
-    from mtpg.envs.task_table import TaskTable, parse_given
+    from mtpg.envs.taskset.task_table import TaskTable, parse_given
 
     references: list[str] = []
     if target.is_dir():

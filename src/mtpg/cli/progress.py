@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 from typing import TextIO
 
-from mtpg.envs.registry import TASKS
+from mtpg.envs.specs.registry import TASKS
 
 #: Short task labels for the status line (the header spells them out): each spec's
 #: ``short``.

@@ -1,7 +1,7 @@
 """Evaluation of many roots x tasks x episodes in one compiled call.
 
 The episode table, the jobs and the outputs are named tuples of arrays, each passed to the
-kernels as one argument (:mod:`mtpg.engine.kernels`).
+kernels as one argument (:mod:`mtpg.engine.episode_kernels`).
 """
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import numba
 import numpy as np
 
 from mtpg.engine.compile import CompiledPopulation
-from mtpg.engine.kernels import run_jobs_parallel, run_jobs_queue
+from mtpg.engine.episode_kernels import run_jobs_parallel, run_jobs_queue
 from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_parallel, run_lanes_queue
-from mtpg.envs.episodes import draw_episodes
-from mtpg.envs.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.episodes import draw_episodes
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
 
 
 class Episodes(NamedTuple):
@@ -27,7 +27,7 @@ class Episodes(NamedTuple):
         starts: float64 ``[n, STATE_SIZE]``.
         noise: float64 ``[n, T + 1]``.
         obs_noise: float64 ``[n, T + 1, 2]``: the observation noise of variants with
-            ``noise`` (:func:`mtpg.envs.episodes.draw_episodes`), or ``[n, 0, 2]``.
+            ``noise`` (:func:`mtpg.envs.taskset.episodes.draw_episodes`), or ``[n, 0, 2]``.
         params: float64 ``[ids, N_PARAMS]``: the parameter table the task ids index
             (the ``params`` of the task table the episodes were drawn from).
     """

@@ -44,7 +44,7 @@ class Graph(NamedTuple):
 
     A named tuple of arrays and sizes (Numba passes it as one typed argument), so two
     arrays can never be swapped at a call. The kernels read it in
-    :func:`mtpg.engine.kernels.decide`; docs/engine.md says where a new array goes.
+    :func:`mtpg.engine.episode_kernels.decide`; docs/engine.md says where a new array goes.
 
     Attributes:
         team_offsets: int64 ``[n_teams + 1]``: members of team ``t`` are

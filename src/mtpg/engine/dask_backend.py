@@ -6,7 +6,7 @@ Per evaluation the compiled population travels once to every worker as plain Num
 about :data:`TASKS_PER_THREAD` batches per worker thread, each root with all its episodes
 (so a worker plays one graph's episodes back to back, its code and memory banks in cache),
 each batch one task that runs the serial compiled kernel of
-:mod:`mtpg.engine.kernels` (importable, ``cache=True``: each worker process compiles or
+:mod:`mtpg.engine.episode_kernels` (importable, ``cache=True``: each worker process compiles or
 loads the kernels once, on its first task), and the outcomes are put back in job order.
 Results are bit-identical to the local backend's.
 

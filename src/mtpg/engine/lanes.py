@@ -6,14 +6,14 @@ standing at the same team form a *group*, and each program of the team runs once
 its group, its instruction dispatched once for all the group's lanes (the inner loop
 runs over lanes with the same op code, so its branch is predicted and its loads and
 stores stride through lane-contiguous memory). Then each lane takes its own highest bid
-under its own visited-team rule, exactly as :func:`mtpg.engine.kernels.decide`, and the
+under its own visited-team rule, exactly as :func:`mtpg.engine.episode_kernels.decide`, and the
 lanes split into the groups of the teams they move to. When every lane has reached an
 atomic action, each lane's task takes one step; a lane whose episode ends leaves.
 
 Each lane computes exactly the operations the scalar kernel computes, in the same order,
 with the same operation functions (:mod:`mtpg.engine.lane_ops`; no vector math library:
 a lane's ``cos`` is the same scalar call), so every job's return, steps, teams visited and
-instructions executed are bit for bit those of :func:`~mtpg.engine.kernels.run_jobs_queue`
+instructions executed are bit for bit those of :func:`~mtpg.engine.episode_kernels.run_jobs_queue`
 (tested), whatever the lane-block size, the order of the jobs or the threads.
 
 Layout: each lane block plays its own compact copy of its graph
@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from mtpg.engine.kernels import _fetch_add
+from mtpg.engine.episode_kernels import _fetch_add
 from mtpg.engine.lane_graph import (
     C_A,
     C_B,
@@ -48,9 +48,15 @@ from mtpg.engine.lane_graph import (
     unlocalise,
 )
 from mtpg.engine.lane_ops import lane_op
-from mtpg.envs.core import STATE_SIZE
-from mtpg.envs.kernels import add_obs_noise, env_reset, observe_kind, task_observe, task_step
-from mtpg.envs.tasks import P_KIND, P_OBS_SD
+from mtpg.envs.dynamics.dispatch import (
+    add_obs_noise,
+    env_reset,
+    observe_kind,
+    task_observe,
+    task_step,
+)
+from mtpg.envs.specs.contract import STATE_SIZE
+from mtpg.envs.specs.param_table import P_KIND, P_OBS_SD
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
 _CONSTANTS = CONSTANTS.copy()
@@ -64,7 +70,7 @@ DEFAULT_LANES = 32
 def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
     """One worker of the lane engine: takes blocks of jobs from a shared queue.
 
-    The queue is :func:`~mtpg.engine.kernels.run_jobs_queue`'s (block ``b`` is jobs
+    The queue is :func:`~mtpg.engine.episode_kernels.run_jobs_queue`'s (block ``b`` is jobs
     ``b * block ... (b + 1) * block - 1``); each queue block is played in lane blocks of
     up to ``lanes`` consecutive jobs. Jobs of a lane block may have different roots.
 

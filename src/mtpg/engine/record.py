@@ -1,4 +1,4 @@
-"""The recorder of a traced run: what :func:`~mtpg.engine.kernels.decide` did, row by row.
+"""The recorder of a traced run: what :func:`~mtpg.engine.episode_kernels.decide` did, row by row.
 
 The production kernels pass ``rec=None`` and Numba prunes every ``if rec is not None:``
 branch, hooks included, from their compiled code (it can because ``rec`` is never
@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from mtpg.envs.core import STATE_SIZE
+from mtpg.envs.specs.contract import STATE_SIZE
 from mtpg.model.instructions import CONDITIONAL_OPS, UNARY_OPS
 
 _FIRST_UNARY = min(UNARY_OPS)

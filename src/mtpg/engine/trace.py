@@ -1,7 +1,7 @@
 """Traced execution: what every decision did, for the tests and the analyses of section 6.
 
-The production :func:`~mtpg.engine.kernels.decide` and
-:func:`~mtpg.engine.kernels.run_jobs_queue` with a :class:`~mtpg.engine.record.Recorder`
+The production :func:`~mtpg.engine.episode_kernels.decide` and
+:func:`~mtpg.engine.episode_kernels.run_jobs_queue` with a :class:`~mtpg.engine.record.Recorder`
 (the training path passes none, and Numba compiles the recording out of it): one compiled
 copy of the decision semantics. Per decision it records the teams visited, every program
 executed with its bid, every instruction executed, and every memory register read or
@@ -18,7 +18,7 @@ from numba import njit
 
 from mtpg.engine.batch import BatchResult, Episodes, Jobs
 from mtpg.engine.compile import CompiledPopulation
-from mtpg.engine.kernels import decide, run_jobs_queue, thread_buffers
+from mtpg.engine.episode_kernels import decide, run_jobs_queue, thread_buffers
 from mtpg.engine.record import (
     INSTRUCTIONS,
     MEMORY,

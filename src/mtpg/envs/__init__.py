@@ -4,11 +4,13 @@ Importing this package registers the Gymnasium ids ``mtpg/<Task>-v0`` (only Gymn
 imported for that). The numba-backed names below load on first access, so the import
 itself stays light.
 
-Public names: ``TASK_NAMES``, ``STATE_SIZE`` and the task ids (``mtpg.envs.core``);
+Public names: ``TASK_NAMES``, ``STATE_SIZE`` and the task ids (``mtpg.envs.specs.contract``);
 ``TASK_PARAMS``, ``N_PARAMS``, ``MAX_STEPS``, ``ACTION_BOUND``, ``USES_CONTINUOUS``,
-``STATE_DIMS`` (``mtpg.envs.tasks``); ``env_reset``, ``env_observe``, ``env_step``
-(``mtpg.envs.kernels``); ``sample_start``, ``make_episodes`` (``mtpg.envs.episodes``);
-``MtpgEnv`` (``mtpg.envs.gym_env``); ``REFERENCE``, ``normalise`` (``mtpg.envs.reference``).
+``STATE_DIMS`` (``mtpg.envs.specs.param_table``); ``env_reset``, ``env_observe``, ``env_step``
+(``mtpg.envs.dynamics.dispatch``); ``sample_start``, ``make_episodes``
+(``mtpg.envs.taskset.episodes``); ``MtpgEnv`` (``mtpg.envs.gym_api.env``); ``REFERENCE``,
+``normalise`` (``mtpg.envs.taskset.reference_scores``). The layers beneath (``specs``,
+``dynamics``, ``taskset``, ``gym_api``): docs/architecture.md.
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from mtpg.envs.core import (
+from mtpg.envs.gym_api.registration import GYM_IDS, register_envs
+from mtpg.envs.specs.contract import (
     ACROBOT,
     CARTCENTERING,
     CARTPOLE,
@@ -29,14 +32,11 @@ from mtpg.envs.core import (
     STEP_SLOT,
     TASK_NAMES,
 )
-from mtpg.envs.registration import GYM_IDS, register_envs
 
 if TYPE_CHECKING:
-    from mtpg.envs.episodes import make_episodes, sample_start
-    from mtpg.envs.gym_env import MtpgEnv
-    from mtpg.envs.kernels import env_observe, env_reset, env_step
-    from mtpg.envs.reference import REFERENCE, normalise
-    from mtpg.envs.tasks import (
+    from mtpg.envs.dynamics.dispatch import env_observe, env_reset, env_step
+    from mtpg.envs.gym_api.env import MtpgEnv
+    from mtpg.envs.specs.param_table import (
         ACTION_BOUND,
         MAX_STEPS,
         N_PARAMS,
@@ -44,22 +44,24 @@ if TYPE_CHECKING:
         TASK_PARAMS,
         USES_CONTINUOUS,
     )
+    from mtpg.envs.taskset.episodes import make_episodes, sample_start
+    from mtpg.envs.taskset.reference_scores import REFERENCE, normalise
 
 _LAZY: dict[str, str] = {
-    "TASK_PARAMS": "mtpg.envs.tasks",
-    "N_PARAMS": "mtpg.envs.tasks",
-    "MAX_STEPS": "mtpg.envs.tasks",
-    "ACTION_BOUND": "mtpg.envs.tasks",
-    "USES_CONTINUOUS": "mtpg.envs.tasks",
-    "STATE_DIMS": "mtpg.envs.tasks",
-    "env_reset": "mtpg.envs.kernels",
-    "env_observe": "mtpg.envs.kernels",
-    "env_step": "mtpg.envs.kernels",
-    "sample_start": "mtpg.envs.episodes",
-    "make_episodes": "mtpg.envs.episodes",
-    "MtpgEnv": "mtpg.envs.gym_env",
-    "REFERENCE": "mtpg.envs.reference",
-    "normalise": "mtpg.envs.reference",
+    "TASK_PARAMS": "mtpg.envs.specs.param_table",
+    "N_PARAMS": "mtpg.envs.specs.param_table",
+    "MAX_STEPS": "mtpg.envs.specs.param_table",
+    "ACTION_BOUND": "mtpg.envs.specs.param_table",
+    "USES_CONTINUOUS": "mtpg.envs.specs.param_table",
+    "STATE_DIMS": "mtpg.envs.specs.param_table",
+    "env_reset": "mtpg.envs.dynamics.dispatch",
+    "env_observe": "mtpg.envs.dynamics.dispatch",
+    "env_step": "mtpg.envs.dynamics.dispatch",
+    "sample_start": "mtpg.envs.taskset.episodes",
+    "make_episodes": "mtpg.envs.taskset.episodes",
+    "MtpgEnv": "mtpg.envs.gym_api.env",
+    "REFERENCE": "mtpg.envs.taskset.reference_scores",
+    "normalise": "mtpg.envs.taskset.reference_scores",
 }
 
 __all__ = [

@@ -34,10 +34,10 @@ import numpy as np
 from mtpg.config import RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
-from mtpg.envs.protocol import held_out_seeds, resampled_training_seeds
-from mtpg.envs.reference import reference_of
-from mtpg.envs.task_table import TaskTable
-from mtpg.evolve.testing import local_evaluate
+from mtpg.envs.taskset.episode_seeds import held_out_seeds, resampled_training_seeds
+from mtpg.envs.taskset.reference_scores import reference_of
+from mtpg.envs.taskset.task_table import TaskTable
+from mtpg.evolve.heldout_test import local_evaluate
 from mtpg.model.graph import Population
 
 #: First element of the ``SeedSequence`` spawn key of a redrawn noise row (ASCII "nois"):

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from mtpg.config import EXTENSIONS, ConfigError, RunConfig, from_dict, to_dict
-from mtpg.envs.core import N_OBS
+from mtpg.envs.specs.contract import N_OBS
 from mtpg.evolve.trainer import TrainerState
 from mtpg.io.serialize import FormatError, population_from_dict, population_to_dict
 

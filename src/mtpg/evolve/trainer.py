@@ -17,11 +17,11 @@ from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
 from mtpg.engine.evaluator import Evaluator
-from mtpg.envs.protocol import resampled_training_seeds, validation_seeds
+from mtpg.envs.taskset.episode_seeds import resampled_training_seeds, validation_seeds
 from mtpg.evolve.backend import make_evaluator
+from mtpg.evolve.heldout_test import play_test
 from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
-from mtpg.evolve.testing import play_test
 from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
 from mtpg.model.graph import Population
@@ -232,7 +232,7 @@ class Trainer:
     def held_out_scores(self) -> list[dict[str, float | int | str]]:
         """Tests the champion of every task subset on held-out episodes of every task.
 
-        Each distinct champion plays the test (:func:`mtpg.evolve.testing.play_test`):
+        Each distinct champion plays the test (:func:`mtpg.evolve.heldout_test.play_test`):
         ``test_episodes`` held-out episodes of each active task; nothing random is drawn,
         so testing leaves the run unchanged.
 

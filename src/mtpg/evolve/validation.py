@@ -4,13 +4,13 @@ The paper reports the test scores of champions chosen by training score. With
 ``evaluation.validation_episodes = V > 0``, every generation each subset's champion is
 chosen among its best ``evaluation.validation_top_k`` surviving roots by training fitness
 (:func:`mtpg.evolve.selection.candidates`) by a score on ``V`` validation episodes per task
-(seeds :func:`mtpg.envs.protocol.validation_seeds`, disjoint from training and test).
+(seeds :func:`mtpg.envs.taskset.episode_seeds.validation_seeds`, disjoint from training and test).
 
 The rule for a subset is the paper's multi-task rule, the minimum over the subset's tasks
 of a normalised score, with one difference forced by the few candidates: scores are
 normalised against the task's fixed reference, ``(score - random) / (best - random)``
-(:func:`mtpg.envs.reference.normalise`, the scale every reported test score uses), not
-min-max over the candidates. Min-max over a handful of roots would give every task's worst
+(:func:`mtpg.envs.taskset.reference_scores.normalise`, the scale every reported test score uses),
+not min-max over the candidates. Min-max over a handful of roots would give every task's worst
 candidate 0 and so make most multi-task fitnesses 0; a fixed scale ranks candidates the
 same whichever others stand beside them. For a single task the rule orders candidates by
 their mean validation score. Ties go to the better root by training fitness.
@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs.reference import normalise
-from mtpg.envs.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.reference_scores import normalise
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
 
 
 def validation_fitness(

@@ -9,7 +9,7 @@ decisions alone.
 * **C**: the exported code compiled with ``-O2 -ffp-contract=off`` into the driver of
   :mod:`mtpg.export.harness`, playing the stream ``repeats`` times per run; CPU time by
   ``clock()``. Before timing, the driver's actions are checked bitwise against the engine's.
-* **engine**: :func:`mtpg.engine.kernels.decide` (the kernel training runs) called from
+* **engine**: :func:`mtpg.engine.episode_kernels.decide` (the kernel training runs) called from
   one compiled loop over the same stream, one thread; wall time around that call.
 * **Python**: the exported module's ``reset``/``act`` over the stream once per run.
 
@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit
 
 from mtpg.engine.compile import compile_population
-from mtpg.engine.kernels import decide, thread_buffers
+from mtpg.engine.episode_kernels import decide, thread_buffers
 from mtpg.export.c import write_c
 from mtpg.export.common import ExportGraph
 from mtpg.export.harness import (

@@ -7,7 +7,7 @@ them (:func:`mtpg.engine.compile.effective_mask`), and the memory banks those
 programs point to, all renumbered densely from 0. The code generators then only print.
 
 The execution semantics the generated code reproduces are those of
-:func:`mtpg.engine.kernels.decide` and :func:`mtpg.engine.ops.apply_op`:
+:func:`mtpg.engine.episode_kernels.decide` and :func:`mtpg.engine.ops.apply_op`:
 
 * a decision starts at the root with no team visited; visiting a team marks it, then runs
   ALL its programs in team order (losers write memory too); each run zeroes the private

@@ -3,7 +3,7 @@
 Private registers start every run at 0 and constants are constants, so a part of many
 programs computes the same values at every decision. :func:`lower` runs such instructions
 once, at export time, with the engine's reference table
-(:func:`mtpg.engine.reference.reference_op`, bit-identical with the compiled engine),
+(:func:`mtpg.engine.oracle.reference_op`, bit-identical with the compiled engine),
 and substitutes their results as literals. What is left reads the observation or memory.
 
 Why here and not in the C compiler: a compiler folds calls such as ``exp(-0.3)`` with its
@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mtpg.engine.reference import reference_op
+from mtpg.engine.oracle import reference_op
 from mtpg.model.instructions import (
     BINARY_OPS,
     CONDITIONAL_OPS,

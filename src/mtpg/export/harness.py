@@ -27,7 +27,7 @@ import numpy as np
 from mtpg.engine.compile import compile_population
 from mtpg.engine.trace import trace_episode
 from mtpg.envs import env_observe
-from mtpg.envs.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
 from mtpg.model.graph import Population
 
 #: Flags of every compilation: C99, warnings as errors, no floating-point contraction.

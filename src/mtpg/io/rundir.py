@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg._faults import point
-from mtpg.envs.core import TASK_NAMES
+from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
 from mtpg.io.checkpoint import CHECKPOINT_DIR
 from mtpg.io.lock import LOCK_FILE
@@ -398,7 +398,7 @@ def canonical_tasks(task_names: Iterable[str]) -> tuple[str, ...]:
     Raises:
         ValueError: For an empty set, an unknown name or a repeat.
     """
-    from mtpg.envs.variants import canonical, order_key
+    from mtpg.envs.taskset.variants import canonical, order_key
 
     names = tuple(task_names)
     unknown = []

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from mtpg.envs.core import N_OBS
+from mtpg.envs.specs.contract import N_OBS
 from mtpg.io._atomic import atomic_write_bytes
 from mtpg.io._bounded import MAX_GRAPH_BYTES, TooLargeError, check_depth, limit, read_file_bounded
 from mtpg.io._readable import Encoded, dumps_readable, encode_at
@@ -106,7 +106,7 @@ def _layout_from(value: Any) -> RegisterLayout:
     extra = sorted(set(obj) - set(_LAYOUT_KEYS))
     if extra:
         raise FormatError(f"layout has unknown keys {extra}")
-    if sizes["n_obs"] != N_OBS:  # every task observes two values (mtpg.envs.core.N_OBS)
+    if sizes["n_obs"] != N_OBS:  # every task observes two values (mtpg.envs.specs.contract.N_OBS)
         raise FormatError(
             f"layout.n_obs must be {N_OBS} (the tasks' interface), got {sizes['n_obs']}"
         )

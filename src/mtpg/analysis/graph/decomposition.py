@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.analysis.graph.replay import Replay
-from mtpg.envs.variants import task_spec
+from mtpg.envs.taskset.variants import task_spec
 
 
 def decomposition(replay: Replay, n_teams: int) -> dict[str, object]:

@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from mtpg.analysis.graph.replay import Replay
-from mtpg.envs.registry import TASKS
-from mtpg.envs.variants import task_spec
+from mtpg.envs.specs.registry import TASKS
+from mtpg.envs.taskset.variants import task_spec
 
 #: State slot of the hidden velocity each task's analysis tracks (section 6.3), each spec's
 #: ``velocity_slot``: CartPole the pole's angular velocity, Acrobot the first joint's (the

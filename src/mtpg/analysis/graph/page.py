@@ -29,7 +29,7 @@ from mtpg.analysis.runs.hierarchical_complexity import (
     mean_by_size,
     run_complexity,
 )
-from mtpg.envs.task_table import TaskTable
+from mtpg.envs.taskset.task_table import TaskTable
 from mtpg.model.graph import Population
 
 

@@ -1,8 +1,8 @@
 """Traced replays of a graph on test episodes, and their ``.npz`` file format.
 
 A replay plays the same held-out episodes as ``mtpg evaluate`` (seeds from
-:func:`mtpg.envs.protocol.held_out_seeds`) with the tracing kernel, which follows exactly the
-decisions of the batch kernel, so the returns are equal.
+:func:`mtpg.envs.taskset.episode_seeds.held_out_seeds`) with the tracing kernel, which follows
+exactly the decisions of the batch kernel, so the returns are equal.
 
 ``.npz`` schema (version 1). ``N`` steps over all episodes, ``E`` episodes, teams, banks
 and programs numbered as in :mod:`mtpg.analysis.description.numbering` (team 1 is the root). Ragged
@@ -24,7 +24,7 @@ episode_seeds          (E,)        episode seeds
 returns                (E,)        episode returns
 episode_offsets        (E + 1,)    steps of episode ``e``: ``episode_offsets[e]:[e + 1]``
 episode, step          (N,)        episode index and step within the episode
-hidden_state           (N, 6)      full task state before the decision (see envs.core)
+hidden_state           (N, 6)      full task state before the decision (see envs.specs.contract)
 observation            (N, 2)      the inputs ``s(t)`` the decision saw
 a_d, a_c, reward       (N,)        discrete action, continuous action, reward of the step
 final_state            (E, 6)      task state after the last step
@@ -60,10 +60,10 @@ import numpy as np
 from mtpg.analysis.description.numbering import effective_instruction_map, index_graph
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
-from mtpg.envs.episodes import draw_episodes
-from mtpg.envs.protocol import held_out_seeds
-from mtpg.envs.task_table import TaskTable
-from mtpg.envs.variants import canonical, known
+from mtpg.envs.taskset.episode_seeds import held_out_seeds
+from mtpg.envs.taskset.episodes import draw_episodes
+from mtpg.envs.taskset.task_table import TaskTable
+from mtpg.envs.taskset.variants import canonical, known
 from mtpg.model.graph import Population
 
 SCHEMA_VERSION = 1

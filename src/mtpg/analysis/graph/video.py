@@ -15,8 +15,8 @@ from mtpg.analysis.description.layout import GraphDrawing, GraphLayout
 from mtpg.analysis.graph.replay import Replay
 from mtpg.analysis.palette import task_colour
 from mtpg.analysis.plotting import pyplot
-from mtpg.envs.render import make_renderer
-from mtpg.envs.variants import task_spec
+from mtpg.envs.gym_api.render import make_renderer
+from mtpg.envs.taskset.variants import task_spec
 
 #: File endings of the formats written.
 VIDEO_SUFFIXES = (".gif", ".mp4")

@@ -79,8 +79,8 @@ def training_scores(run: RunData, path: Path) -> dict[str, float]:
     recomputed rather than read so that it does not depend on what a graph file's metadata
     holds.
     """
+    from mtpg.evolve.heldout_test import play_episodes
     from mtpg.evolve.memorisation import champion_training_seeds
-    from mtpg.evolve.testing import play_episodes
     from mtpg.io.serialize import load_graph
 
     pop, root, meta = load_graph(path)

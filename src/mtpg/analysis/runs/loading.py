@@ -25,8 +25,8 @@ import numpy as np
 
 from mtpg.ablations import ABLATION_FIELDS, experiment_label
 from mtpg.config import RunConfig, to_dict
-from mtpg.envs.reference import normalise, reference_of
-from mtpg.envs.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.reference_scores import normalise, reference_of
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.rundir import TESTS_FILE
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mtpg.envs.protocol import describe_held_out
+from mtpg.envs.taskset.episode_seeds import describe_held_out
 from mtpg.evolve.memorisation import (
     DEFAULT_REDRAWS,
     SETS,

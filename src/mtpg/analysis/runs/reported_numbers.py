@@ -9,8 +9,8 @@ For each run:
   of the min-max normalised training score); its graph is
   ``tests/gen-NNNNNN/<all tasks>.json``.
 - **Test score**: its mean return over the run's ``evaluation.test_episodes`` held-out
-  episodes per task (seeds from :func:`mtpg.envs.protocol.held_out_seeds`, offset 0), as
-  written to ``tests.csv``; ``mtpg evaluate RUN`` replays the same graph on the same episodes.
+  episodes per task (seeds from :func:`mtpg.envs.taskset.episode_seeds.held_out_seeds`, offset 0),
+  as written to ``tests.csv``; ``mtpg evaluate RUN`` replays the same graph on the same episodes.
 - **Normalised (reference)**: ``(test - random) / (reference best - random)``.
 - **Single-task denominator**: the run's own single-task champion of the task at the same
   generation, again chosen by training score (never by test score), and its test score on
@@ -39,7 +39,7 @@ from mtpg.analysis.runs.champions import (
     training_scores,
 )
 from mtpg.analysis.runs.loading import RunData, normalise_scores, reference_best
-from mtpg.envs.protocol import describe_held_out
+from mtpg.envs.taskset.episode_seeds import describe_held_out
 
 #: How the best run is chosen, in words.
 BEST_RUN_RULE = (

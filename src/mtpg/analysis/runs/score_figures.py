@@ -21,7 +21,7 @@ from mtpg.analysis.runs.reported_numbers import (
     best_single_task,
     describe,
 )
-from mtpg.envs.protocol import describe_held_out
+from mtpg.envs.taskset.episode_seeds import describe_held_out
 
 Numbers = dict[Path, RunNumbers]  # run directory -> its numbers
 

@@ -3,7 +3,7 @@
 One agent meets the tasks episode by episode and is never told which one it plays: at
 each reset a task is drawn from the environment's seeded generator over the chosen tasks
 (``order="random"``) or taken in turn (``order="cycle"``), and the episode is played by
-that task's :class:`~mtpg.envs.gym_env.MtpgEnv`. The observation is the task's two inputs,
+that task's :class:`~mtpg.envs.gym_api.env.MtpgEnv`. The observation is the task's two inputs,
 with no task label. ``info["task"]`` names the task, for logging only: an agent fed it no
 longer faces the paper's problem.
 
@@ -32,9 +32,9 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from mtpg.envs.core import N_OBS
-from mtpg.envs.gym_env import MtpgEnv, paper_action_space
-from mtpg.envs.registry import PAPER_TASKS, TASKS, task_id
+from mtpg.envs.gym_api.env import MtpgEnv, paper_action_space
+from mtpg.envs.specs.contract import N_OBS
+from mtpg.envs.specs.registry import PAPER_TASKS, TASKS, task_id
 
 #: The action interfaces of the multi-task environment.
 MULTITASK_ACTIONS: tuple[str, ...] = ("box", "tuple")

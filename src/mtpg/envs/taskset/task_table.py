@@ -1,18 +1,18 @@
 """The task table of a run: its tasks' ids, specs, parameter rows and given reference scores.
 
 A :class:`TaskTable` is one immutable value, built once from task names (registered names
-or variants, :mod:`mtpg.envs.variants`) and the reference scores given for variants
+or variants, :mod:`mtpg.envs.taskset.variants`) and the reference scores given for variants
 (:class:`GivenReference`). Everything that plays or scores a task takes the table: the
 trainer, the episode tables, the test protocol, evaluation, export and the analyses. Nothing
 about tasks is held by the process: two tables with different variants live side by side.
 
-Ids: a registered task's id is its index in the registry (:data:`mtpg.envs.registry.TASKS`)
+Ids: a registered task's id is its index in the registry (:data:`mtpg.envs.specs.registry.TASKS`)
 in every table; the table's variants get ``VARIANT_ID_BASE + k`` in order of first
 appearance, so an id past the registry stays unknown until a task is registered under it.
 Ids are table-local; names are what runs, checkpoints and graph files store.
 
 The table's ``params`` is the float64 parameter table the compiled kernels index by id:
-the registered rows (:data:`mtpg.envs.tasks.TASK_PARAMS`), padding up to
+the registered rows (:data:`mtpg.envs.specs.param_table.TASK_PARAMS`), padding up to
 ``VARIANT_ID_BASE`` (rows whose kind has no branch), then one row per variant.
 """
 
@@ -24,10 +24,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from mtpg.envs.registry import TASK_NAMES, TASKS
-from mtpg.envs.tasks import TASK_PARAMS, param_row, params_table
-from mtpg.envs.taskspec import TaskSpec
-from mtpg.envs.variants import canonical, is_variant, variant_row, variant_spec
+from mtpg.envs.specs.param_table import TASK_PARAMS, param_row, params_table
+from mtpg.envs.specs.registry import TASK_NAMES, TASKS
+from mtpg.envs.specs.task_spec import TaskSpec
+from mtpg.envs.taskset.variants import canonical, is_variant, variant_row, variant_spec
 
 #: The first variant id of a table (registered tasks keep 0..).
 VARIANT_ID_BASE = 256

@@ -16,7 +16,7 @@ Conventions (used by the stored figures and by the re-measuring functions):
   1_000_099). The CartCentering reference best is the mean score of the time-optimal law on
   these episodes.
 
-A variant's reference scores come from its task table (:mod:`mtpg.envs.task_table`): the
+A variant's reference scores come from its task table (:mod:`mtpg.envs.taskset.task_table`): the
 scores given for it there, else its base task's best and a random score measured on the
 variant itself. The measurement is a pure function of the variant's name, memoised
 (:func:`measured_random`); nothing else is kept between calls.
@@ -28,19 +28,19 @@ from functools import cache
 
 import numpy as np
 
-from mtpg.envs.core import CARTCENTERING
-from mtpg.envs.episodes import make_episodes
-from mtpg.envs.protocol import (  # noqa: F401  (the seed bases live in protocol)
+from mtpg.envs.dynamics.rollout import run_episodes, run_time_optimal
+from mtpg.envs.specs.contract import CARTCENTERING
+from mtpg.envs.specs.param_table import TASK_PARAMS
+from mtpg.envs.specs.registry import TASKS
+from mtpg.envs.specs.task_spec import NONE, Reference
+from mtpg.envs.taskset.episode_seeds import (  # noqa: F401  (the seed bases live in protocol)
     N_TEST_EPISODES,
     RANDOM_SEED_BASE,
     TEST_SEED_BASE,
     held_out_seeds,
 )
-from mtpg.envs.registry import TASKS
-from mtpg.envs.rollout import run_episodes, run_time_optimal
-from mtpg.envs.task_table import REGISTERED, TaskTable
-from mtpg.envs.tasks import TASK_PARAMS
-from mtpg.envs.taskspec import NONE, Reference
+from mtpg.envs.taskset.episodes import make_episodes
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
 
 #: Seed of the random agent's action generator.
 RANDOM_ACTION_SEED = 12345
@@ -124,7 +124,7 @@ def measure_time_optimal_cartcentering(
 
 
 #: One entry per task id, from the registry (each spec's ``reference``, with its source
-#: in ``mtpg.envs.registry``). ``random`` / ``random_std``: measured by this project with
+#: in ``mtpg.envs.specs.registry``). ``random`` / ``random_std``: measured by this project with
 #: ``measure_random(task)`` (10,000 episodes, conventions in the module docstring).
 #: Re-measured by ``tests/envs/test_reference.py`` (slow).
 REFERENCE: tuple[Reference, ...] = tuple(t.reference for t in TASKS)

@@ -2,7 +2,7 @@
 
 A spec names the task's compiled kernels by module and function (``kernel_module``,
 ``step``, ``observe``, ``sample_start``) rather than holding them, so that the registry
-(:mod:`mtpg.envs.registry`) loads without Numba: importing :mod:`mtpg.envs` registers the
+(:mod:`mtpg.envs.specs.registry`) loads without Numba: importing :mod:`mtpg.envs` registers the
 Gymnasium ids from the registry alone. :meth:`TaskSpec.kernel` imports the function on
 demand.
 """
@@ -22,7 +22,7 @@ class Reference(NamedTuple):
     """Reference figures of one task.
 
     Attributes:
-        random: Mean score of the random agent (see :mod:`mtpg.envs.reference`).
+        random: Mean score of the random agent (see :mod:`mtpg.envs.taskset.reference_scores`).
         random_std: Standard deviation of that score.
         best: Reference best score (Fig. 6 normalisation).
         solved: Registered solved threshold, or NaN when there is none.
@@ -43,7 +43,7 @@ class TaskSpec:
     Attributes:
         name: Task name (also the Gymnasium id ``mtpg/<name>-v0``).
         short: Short name of the progress lines (two or three capitals).
-        kernel_module: Module holding the compiled kernels, e.g. ``"mtpg.envs.cartpole"``.
+        kernel_module: Module holding the compiled kernels, e.g. ``"mtpg.envs.dynamics.cartpole"``.
         step: Name of the step kernel ``step(p, state, action) -> (reward, terminated)``.
         observe: Name of the observation kernel ``observe(p, state, noise, obs)``.
         sample_start: Name of the start sampler ``sample_start(rng) -> physical state``.
@@ -54,7 +54,7 @@ class TaskSpec:
             ``kernel_module``); a variant overrides a parameter by this name.
         state_names: Names of the physical state variables, in Gymnasium's order.
         state_low: Per state variable, the low end of the range a variant's observation
-            scales to -1 (see :mod:`mtpg.envs.variants`).
+            scales to -1 (see :mod:`mtpg.envs.taskset.variants`).
         state_high: Per state variable, the high end of that range (scaled to +1).
         angle_slots: State slots holding angles, wrapped into [-pi, pi) before scaling.
         observed_slots: State slots the task's own observation reads (the rest of the two
@@ -66,8 +66,8 @@ class TaskSpec:
         velocity_slot: State slot of the hidden velocity the section-6 analyses track.
         colour: The task's colour in every section-6 figure.
         render: Gymnasium ``classic_control`` class drawing the task, or ``""`` for a
-            renderer of :mod:`mtpg.envs.render` named ``<name>Renderer``.
-        base: For a variant (:mod:`mtpg.envs.variants`), the name of its registered base
+            renderer of :mod:`mtpg.envs.gym_api.render` named ``<name>Renderer``.
+        base: For a variant (:mod:`mtpg.envs.taskset.variants`), the name of its registered base
             task; ``""`` for a registered task.
     """
 

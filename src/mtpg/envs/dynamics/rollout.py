@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from mtpg.envs.cartcentering import time_optimal_action
-from mtpg.envs.core import CARTCENTERING, N_OBS, STATE_SIZE
-from mtpg.envs.kernels import env_observe, env_reset, env_step
+from mtpg.envs.dynamics.cartcentering import time_optimal_action
+from mtpg.envs.dynamics.dispatch import env_observe, env_reset, env_step
+from mtpg.envs.specs.contract import CARTCENTERING, N_OBS, STATE_SIZE
 
 
 @njit(cache=True, error_model="numpy")

@@ -1,18 +1,19 @@
 """The compiled task interface the execution engine calls: reset, observe and step.
 
 :func:`task_observe` and :func:`task_step` are the one dispatch on the task id: an if-chain
-to the task modules, with a branch per task of the registry (:mod:`mtpg.envs.registry`).
+to the task modules, with a branch per task of the registry (:mod:`mtpg.envs.specs.registry`).
 Every kernel (these, the batch kernel of training, the traced kernel) reaches the task
 modules through them. An id without a branch observes NaN and ends its episode at once
 with a NaN reward, so a task missing from the chain cannot pass for another task
 (``tests/envs/test_dispatch.py`` plays every registered task through every kernel).
 
 The dispatch branches on a row's ``kind`` column (``P_KIND``): a registered task's own id,
-or a variant's base task id (:mod:`mtpg.envs.variants`), so a variant runs its base task's
+or a variant's base task id (:mod:`mtpg.envs.taskset.variants`), so a variant runs its base task's
 kernels on its own parameter row; a row whose ``P_OBS`` column is set is observed by
 :func:`variant_observe`. State lives in a float64 array of ``STATE_SIZE`` slots (see
-``mtpg.envs.core``); parameters are rows of ``TASK_PARAMS`` (see ``mtpg.envs.tasks``) or of
-the ``params`` of a task table (:mod:`mtpg.envs.task_table`).
+``mtpg.envs.specs.contract``); parameters are rows of ``TASK_PARAMS`` (see
+``mtpg.envs.specs.param_table``) or of the ``params`` of a task table
+(:mod:`mtpg.envs.taskset.task_table`).
 
 The dispatch and everything it reaches are compiled without reference counting
 (:data:`step_kernel`): they take arrays and allocate none, while a function compiled with
@@ -30,9 +31,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from mtpg.envs import acrobot, cartcentering, cartpole, mountaincar, pendulum
-from mtpg.envs._util import clip_obs
-from mtpg.envs.core import (
+from mtpg.envs.dynamics import acrobot, cartcentering, cartpole, mountaincar, pendulum
+from mtpg.envs.dynamics.numeric import clip_obs
+from mtpg.envs.specs.contract import (
     ACROBOT,
     CARTCENTERING,
     CARTPOLE,
@@ -43,7 +44,7 @@ from mtpg.envs.core import (
     STATE_SIZE,
     STEP_SLOT,
 )
-from mtpg.envs.tasks import (
+from mtpg.envs.specs.param_table import (
     OBS_COS,
     OBS_SIN,
     OBS_WRAP,

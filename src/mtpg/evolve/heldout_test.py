@@ -1,8 +1,8 @@
 """The test protocol: roots x tasks x held-out episodes, and the scores it reports.
 
 One function plays a test (:func:`play_test`): every root plays the same ``episodes``
-held-out episodes of every task (seeds :func:`mtpg.envs.protocol.held_out_seeds`, disjoint
-from training), deterministically, so testing draws nothing random and a test repeated on
+held-out episodes of every task (seeds :func:`mtpg.envs.taskset.episode_seeds.held_out_seeds`,
+disjoint from training), deterministically, so testing draws nothing random and a test repeated on
 the same graph gives the same numbers. The trainer tests its champions with it at every
 test point (``tests.csv``); ``mtpg evaluate``, ``mtpg report`` and the analyses test a
 graph with it through :func:`evaluate_graph`. :func:`play_episodes` is the same grid on
@@ -18,9 +18,9 @@ import numpy as np
 
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import CompiledPopulation, compile_population
-from mtpg.envs.protocol import held_out_seeds
-from mtpg.envs.reference import normalise, reference_of
-from mtpg.envs.task_table import REGISTERED, GivenReference, TaskTable
+from mtpg.envs.taskset.episode_seeds import held_out_seeds
+from mtpg.envs.taskset.reference_scores import normalise, reference_of
+from mtpg.envs.taskset.task_table import REGISTERED, GivenReference, TaskTable
 from mtpg.model.graph import Population
 
 #: ``evaluate(compiled, roots, table, no_memory) -> (returns, result)``: how the episodes
@@ -114,8 +114,8 @@ def play_test(
 ) -> PlayedEpisodes:
     """The test: :func:`play_episodes` on ``episodes`` held-out episodes of every task.
 
-    The seeds are :func:`mtpg.envs.protocol.held_out_seeds` ``(episodes, seed)``: ``seed``
-    is their offset, 0 for a run's own test points. ``task_ids`` are ids of ``table``.
+    The seeds are :func:`mtpg.envs.taskset.episode_seeds.held_out_seeds` ``(episodes, seed)``:
+    ``seed`` is their offset, 0 for a run's own test points. ``task_ids`` are ids of ``table``.
     """
     seeds = held_out_seeds(episodes, seed)
     return play_episodes(pop, roots, task_ids, seeds, no_memory, evaluate, table)
@@ -177,12 +177,12 @@ def evaluate_graph(
         root: The root team id.
         tasks: Task names.
         episodes: Episodes per task.
-        seed: Offset of the test seeds (see :func:`mtpg.envs.protocol.held_out_seeds`).
+        seed: Offset of the test seeds (see :func:`mtpg.envs.taskset.episode_seeds.held_out_seeds`).
         workers: Threads.
         no_memory: Evaluate with the no-memory ablation semantics.
         references: Reference scores given for variants among ``tasks`` (a run's
             ``evaluation.references`` entries); the others are normalised as
-            :func:`mtpg.envs.reference.reference_of` says.
+            :func:`mtpg.envs.taskset.reference_scores.reference_of` says.
 
     Returns:
         Scores by task name, in the order given.

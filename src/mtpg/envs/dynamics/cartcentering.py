@@ -15,12 +15,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from mtpg.envs import registry
-from mtpg.envs._util import bang_bang_force, clip, clip_obs
-from mtpg.envs.core import PREV_FORCE_SLOT, STEP_SLOT
+from mtpg.envs.dynamics.numeric import bang_bang_force, clip, clip_obs
+from mtpg.envs.specs import registry
+from mtpg.envs.specs.contract import PREV_FORCE_SLOT, STEP_SLOT
 
 # Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
-# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+# common to all tasks, see ``mtpg.envs.specs.param_table``); checked by
+# tests/envs/test_param_columns.py.
 (
     MAX_STEPS,
     FORCE,
@@ -33,7 +34,7 @@ from mtpg.envs.core import PREV_FORCE_SLOT, STEP_SLOT
     TIME_COST,
 ) = range(len(registry.CARTCENTERING.param_names))
 
-#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.specs.registry``).
 PARAMS: tuple[float, ...] = registry.CARTCENTERING.params
 
 STATE_DIM = registry.CARTCENTERING.state_dim

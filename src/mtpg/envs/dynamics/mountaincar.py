@@ -15,11 +15,12 @@ import math
 import numpy as np
 from numba import njit
 
-from mtpg.envs import registry
-from mtpg.envs._util import clip_obs, continuous_action
+from mtpg.envs.dynamics.numeric import clip_obs, continuous_action
+from mtpg.envs.specs import registry
 
 # Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
-# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+# common to all tasks, see ``mtpg.envs.specs.param_table``); checked by
+# tests/envs/test_param_columns.py.
 (
     MAX_STEPS,
     FORCE,

@@ -38,15 +38,15 @@ from mtpg.engine.record import (
     record_state,
     record_team,
 )
-from mtpg.envs.core import STATE_SIZE
-from mtpg.envs.kernels import (
+from mtpg.envs.dynamics.dispatch import (
     add_obs_noise,
     env_reset,
     observe_kind,
     task_observe,
     task_step,
 )
-from mtpg.envs.tasks import P_KIND, P_OBS_SD
+from mtpg.envs.specs.contract import STATE_SIZE
+from mtpg.envs.specs.param_table import P_KIND, P_OBS_SD
 from mtpg.model.instructions import CONSTANTS, N_CONSTANTS
 
 _CONSTANTS = CONSTANTS.copy()

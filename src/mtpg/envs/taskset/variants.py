@@ -16,13 +16,13 @@ A variant is a registered task with some of its settings changed, written
 - ``noise_low`` / ``noise_high``: the noise input is ``U[noise_low, noise_high]``
   instead of U[0, 1] (the same draw, mapped linearly; not clipped: the authors' code
   feeds U[-pi, pi]). Only a task with a noise input takes them. These four keys, like
-  ``observe``, make the variant observe through :func:`mtpg.envs.kernels.variant_observe`
+  ``observe``, make the variant observe through :func:`mtpg.envs.dynamics.dispatch.variant_observe`
   (the base's own observed variables when ``observe`` is not given); numbers may be
   written ``pi`` or ``-pi``;
 - ``noise``: Gaussian observation noise: each input that observes the state gets
   ``sd * N(0, 1)`` added (in its [-1, 1] units) and is clipped again; ``sd >= 0``. The
   normal values are drawn per episode after its start state and U[0, 1] values
-  (:func:`mtpg.envs.episodes.draw_episodes`), so a task without noise draws as before.
+  (:func:`mtpg.envs.taskset.episodes.draw_episodes`), so a task without noise draws as before.
 
 The dynamics are the base task's kernels on the variant's parameter row, so a variant
 reproduces its base task step for step and runs in the compiled engine like it. The start
@@ -32,8 +32,8 @@ CartCentering's ``start_range``, keep their base value there).
 A variant's name is canonical (keys sorted, values normalised): :func:`canonical` turns any
 spelling into it, and the configuration stores it as the task's name. This module is pure
 functions of names: a variant's id and parameter row belong to the task table it is in
-(:class:`mtpg.envs.task_table.TaskTable`), its reference scores to
-:func:`mtpg.envs.reference.reference_of`.
+(:class:`mtpg.envs.taskset.task_table.TaskTable`), its reference scores to
+:func:`mtpg.envs.taskset.reference_scores.reference_of`.
 """
 
 from __future__ import annotations
@@ -44,9 +44,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from mtpg.envs.registry import TASK_NAMES, TASKS
-from mtpg.envs.tasks import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP, param_row
-from mtpg.envs.taskspec import NONE, Reference, TaskSpec, variant_gym_id
+from mtpg.envs.specs.param_table import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP, param_row
+from mtpg.envs.specs.registry import TASK_NAMES, TASKS
+from mtpg.envs.specs.task_spec import NONE, Reference, TaskSpec, variant_gym_id
 
 _NAME = re.compile(r"^(?P<base>[A-Za-z][A-Za-z0-9]*)\[(?P<body>[^\[\]]*)\]$")
 

@@ -11,11 +11,12 @@ import math
 import numpy as np
 from numba import njit
 
-from mtpg.envs import registry
-from mtpg.envs._util import clip, clip_obs, continuous_action
+from mtpg.envs.dynamics.numeric import clip, clip_obs, continuous_action
+from mtpg.envs.specs import registry
 
 # Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
-# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+# common to all tasks, see ``mtpg.envs.specs.param_table``); checked by
+# tests/envs/test_param_columns.py.
 (
     MAX_STEPS,
     MAX_TORQUE,
@@ -31,7 +32,7 @@ from mtpg.envs._util import clip, clip_obs, continuous_action
     MAX_VEL_2,
 ) = range(len(registry.ACROBOT.param_names))
 
-#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.specs.registry``).
 PARAMS: tuple[float, ...] = registry.ACROBOT.params
 
 STATE_DIM = registry.ACROBOT.state_dim

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs.core import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT
-from mtpg.envs.task_table import REGISTERED, TaskTable
-from mtpg.envs.variants import obs_noise_sd
+from mtpg.envs.specs.contract import PREV_FORCE_SLOT, STATE_SIZE, STEP_SLOT
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.variants import obs_noise_sd
 
 
 def sample_start(task: int, rng: np.random.Generator, table: TaskTable = REGISTERED) -> np.ndarray:

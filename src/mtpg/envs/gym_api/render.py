@@ -1,6 +1,6 @@
 """Frames of the tasks: Gymnasium's classic-control renderers, and one for CartCentering.
 
-Which renderer draws a task is its spec's ``render`` field (:mod:`mtpg.envs.registry`): a
+Which renderer draws a task is its spec's ``render`` field (:mod:`mtpg.envs.specs.registry`): a
 Gymnasium ``classic_control`` class name, or ``""`` for the class ``<name>Renderer`` here.
 """
 
@@ -10,12 +10,12 @@ from typing import Any
 
 import numpy as np
 
-from mtpg.envs import cartcentering
-from mtpg.envs._util import clip
-from mtpg.envs.core import CARTCENTERING, PENDULUM
-from mtpg.envs.registry import spec
-from mtpg.envs.tasks import TASK_PARAMS
-from mtpg.envs.taskspec import TaskSpec
+from mtpg.envs.dynamics import cartcentering
+from mtpg.envs.dynamics.numeric import clip
+from mtpg.envs.specs.contract import CARTCENTERING, PENDULUM
+from mtpg.envs.specs.param_table import TASK_PARAMS
+from mtpg.envs.specs.registry import spec
+from mtpg.envs.specs.task_spec import TaskSpec
 
 
 class GymRenderer:

@@ -10,12 +10,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from mtpg.envs import registry
-from mtpg.envs._util import bang_bang_force, clip_obs
-from mtpg.envs.core import PREV_FORCE_SLOT
+from mtpg.envs.dynamics.numeric import bang_bang_force, clip_obs
+from mtpg.envs.specs import registry
+from mtpg.envs.specs.contract import PREV_FORCE_SLOT
 
 # Parameter columns: the spec's ``param_names`` upper-cased, in order (columns 0 and 1 are
-# common to all tasks, see ``mtpg.envs.tasks``); tests/envs/test_param_columns.py checks it.
+# common to all tasks, see ``mtpg.envs.specs.param_table``); checked by
+# tests/envs/test_param_columns.py.
 (
     MAX_STEPS,
     FORCE,
@@ -28,7 +29,7 @@ from mtpg.envs.core import PREV_FORCE_SLOT
     THETA_THRESHOLD,
 ) = range(len(registry.CARTPOLE.param_names))
 
-#: Parameter row, in column order (values and their meaning: ``mtpg.envs.registry``).
+#: Parameter row, in column order (values and their meaning: ``mtpg.envs.specs.registry``).
 PARAMS: tuple[float, ...] = registry.CARTPOLE.params
 
 #: Number of hidden physical state variables (x, x_dot, theta, theta_dot).

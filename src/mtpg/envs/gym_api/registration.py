@@ -6,16 +6,16 @@ environment is made. A variant is registered on request (:func:`register`).
 
 from __future__ import annotations
 
-from mtpg.envs.registry import TASKS
+from mtpg.envs.specs.registry import TASKS
 
 #: Gymnasium ids, in task-id order.
 GYM_IDS: tuple[str, ...] = tuple(t.gym_id for t in TASKS)
 
-ENTRY_POINT = "mtpg.envs.gym_env:MtpgEnv"
+ENTRY_POINT = "mtpg.envs.gym_api.env:MtpgEnv"
 
-#: Gymnasium id of the multi-task environment (:mod:`mtpg.envs.multitask`).
+#: Gymnasium id of the multi-task environment (:mod:`mtpg.envs.gym_api.multitask`).
 MULTITASK_ID = "mtpg/MultiTask-v0"
-MULTITASK_ENTRY_POINT = "mtpg.envs.multitask:MultiTaskEnv"
+MULTITASK_ENTRY_POINT = "mtpg.envs.gym_api.multitask:MultiTaskEnv"
 
 
 def register_envs() -> None:
@@ -49,7 +49,7 @@ def register(name: str) -> str:
     """
     import gymnasium
 
-    from mtpg.envs.variants import canonical, gym_id
+    from mtpg.envs.taskset.variants import canonical, gym_id
 
     env_id = gym_id(name)
     if env_id not in gymnasium.registry:

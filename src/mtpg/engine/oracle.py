@@ -179,8 +179,8 @@ def reference_episode(
         ``(return, steps)``.
     """
     from mtpg.envs import env_observe, env_reset, env_step
-    from mtpg.envs.core import STATE_SIZE
-    from mtpg.envs.tasks import TASK_PARAMS
+    from mtpg.envs.specs.contract import STATE_SIZE
+    from mtpg.envs.specs.param_table import TASK_PARAMS
 
     params = TASK_PARAMS if params is None else params
 

@@ -1,7 +1,7 @@
 """The task contract shared by the environment kernels and the execution engine.
 
-A task is an integer id plus data (its :class:`~mtpg.envs.taskspec.TaskSpec` in
-:mod:`mtpg.envs.registry`): one row of a float64 parameter table, a time limit and the
+A task is an integer id plus data (its :class:`~mtpg.envs.specs.task_spec.TaskSpec` in
+:mod:`mtpg.envs.specs.registry`): one row of a float64 parameter table, a time limit and the
 action it reads. Task state lives in a flat float64 array of ``STATE_SIZE`` slots:
 
 ======  ================================================================
@@ -15,9 +15,9 @@ slot    meaning
 
 from __future__ import annotations
 
-from mtpg.envs.registry import TASK_NAMES, task_id
+from mtpg.envs.specs.registry import TASK_NAMES, task_id
 
-# The ids the compiled dispatch (mtpg.envs.kernels.task_step) branches on.
+# The ids the compiled dispatch (mtpg.envs.dynamics.dispatch.task_step) branches on.
 CARTPOLE = task_id("CartPole")
 ACROBOT = task_id("Acrobot")
 CARTCENTERING = task_id("CartCentering")

@@ -1,6 +1,6 @@
-"""Every task constant as arrays, derived from the registry (:mod:`mtpg.envs.registry`).
+"""Every task constant as arrays, derived from the registry (:mod:`mtpg.envs.specs.registry`).
 
-``TASK_PARAMS[task]`` is one row per task id (see ``mtpg.envs.core``). Two columns are
+``TASK_PARAMS[task]`` is one row per task id (see ``mtpg.envs.specs.contract``). Two columns are
 common to all tasks:
 
 ======  ==================================================================
@@ -12,7 +12,7 @@ column  meaning
 ======  ==================================================================
 
 The other columns are task-specific; their names are the column constants of the task
-modules (``mtpg.envs.cartpole``, ``acrobot``, ``cartcentering``, ``pendulum`` and
+modules (``mtpg.envs.dynamics.cartpole``, ``acrobot``, ``cartcentering``, ``pendulum`` and
 ``mountaincar``), and ``docs/envs.md`` lists them. Unused columns are 0.
 """
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mtpg.envs.registry import TASKS
+from mtpg.envs.specs.registry import TASKS
 
 #: Common column: the time limit in steps.
 P_MAX_STEPS = 0
@@ -31,7 +31,7 @@ P_FORCE = 1
 N_TASK_COLUMNS = max(len(t.params) for t in TASKS)
 
 # Interface columns, after every task's own: how the row is dispatched and observed.
-#: The base task's id: the dispatch of ``mtpg.envs.kernels`` branches on it.
+#: The base task's id: the dispatch of ``mtpg.envs.dynamics.dispatch`` branches on it.
 P_KIND = N_TASK_COLUMNS
 #: 0: the task's own observation kernel; 1: a variant's observation (columns below).
 P_OBS = N_TASK_COLUMNS + 1
@@ -121,7 +121,7 @@ def params_table(rows: list[np.ndarray]) -> np.ndarray:
 
 
 #: float64 [N_TASKS, N_PARAMS]: every task constant (read-only); a task table with variants
-#: adds their rows (``mtpg.envs.task_table.TaskTable.params``).
+#: adds their rows (``mtpg.envs.taskset.task_table.TaskTable.params``).
 TASK_PARAMS: np.ndarray = params_table([param_row(t.params, i) for i, t in enumerate(TASKS)])
 
 #: int64 [N_TASKS]: time limits in steps (200, 500, 500, 200, 200, 999).

@@ -2,7 +2,7 @@
 
 One home for the seed bases and the held-out seeds, used by the trainer, the reference
 measurements, ``mtpg evaluate`` and the report alike. Episode seed ``s`` always draws the
-same start state and noise (:func:`mtpg.envs.episodes.make_episodes`), so these ranges fix
+same start state and noise (:func:`mtpg.envs.taskset.episodes.make_episodes`), so these ranges fix
 what every reported number was measured on:
 
 - training episode ``k`` of every task: seed ``TRAIN_SEED_BASE + k`` (0, 1, 2, ...), the

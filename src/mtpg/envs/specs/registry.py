@@ -1,31 +1,32 @@
-"""The task registry: one :class:`~mtpg.envs.taskspec.TaskSpec` per task, in task-id order.
+"""The task registry: one :class:`~mtpg.envs.specs.task_spec.TaskSpec` per task, in task-id order.
 
 Every per-task table of the package is derived from :data:`TASKS`: the parameter table
-and action facts (:mod:`mtpg.envs.tasks`), the task names and ids (:mod:`mtpg.envs.core`),
-the start samplers (:mod:`mtpg.envs.episodes`), the reference scores
-(:mod:`mtpg.envs.reference`), the renderers, the Gymnasium ids, the analyses' velocity
-slots and colours and the progress lines' short names. The id of a task is its index here;
-the compiled dispatch (:func:`mtpg.envs.kernels.task_step`) branches on these ids, and
+and action facts (:mod:`mtpg.envs.specs.param_table`), the task names and ids
+(:mod:`mtpg.envs.specs.contract`), the start samplers (:mod:`mtpg.envs.taskset.episodes`),
+the reference scores (:mod:`mtpg.envs.taskset.reference_scores`), the renderers, the
+Gymnasium ids, the analyses' velocity slots and colours and the progress lines' short
+names. The id of a task is its index here; the compiled dispatch
+(:func:`mtpg.envs.dynamics.dispatch.task_step`) branches on these ids, and
 ``tests/envs/test_dispatch.py`` plays every registered task through every kernel.
 
 This module imports nothing heavy (no NumPy, no Numba), so Gymnasium registration stays
 light. Reference ``random`` / ``random_std`` figures: measured with
-``mtpg.envs.reference.measure_random(task)`` (10,000 episodes), numpy 2.4, numba 0.68;
-re-measured by ``tests/envs/test_reference.py`` (slow).
+``mtpg.envs.taskset.reference_scores.measure_random(task)`` (10,000 episodes), numpy 2.4, numba
+0.68; re-measured by ``tests/envs/test_reference.py`` (slow).
 """
 
 from __future__ import annotations
 
 import math
 
-from mtpg.envs.taskspec import NONE, Reference, TaskSpec
+from mtpg.envs.specs.task_spec import NONE, Reference, TaskSpec
 
 _PI = math.pi
 
 CARTPOLE = TaskSpec(
     name="CartPole",
     short="CP",
-    kernel_module="mtpg.envs.cartpole",
+    kernel_module="mtpg.envs.dynamics.cartpole",
     step="step",
     observe="observe",
     sample_start="sample_start",
@@ -71,7 +72,7 @@ CARTPOLE = TaskSpec(
 ACROBOT = TaskSpec(
     name="Acrobot",
     short="AB",
-    kernel_module="mtpg.envs.acrobot",
+    kernel_module="mtpg.envs.dynamics.acrobot",
     step="step",
     observe="observe",
     sample_start="sample_start",
@@ -122,7 +123,7 @@ ACROBOT = TaskSpec(
 CARTCENTERING = TaskSpec(
     name="CartCentering",
     short="CC",
-    kernel_module="mtpg.envs.cartcentering",
+    kernel_module="mtpg.envs.dynamics.cartcentering",
     step="step",
     observe="observe",
     sample_start="sample_start",
@@ -174,7 +175,7 @@ CARTCENTERING = TaskSpec(
 PENDULUM = TaskSpec(
     name="Pendulum",
     short="PD",
-    kernel_module="mtpg.envs.pendulum",
+    kernel_module="mtpg.envs.dynamics.pendulum",
     step="step",
     observe="observe",
     sample_start="sample_start",
@@ -224,7 +225,7 @@ _MC_STATE = dict(
 MOUNTAINCAR = TaskSpec(
     name="MountainCar",
     short="MC",
-    kernel_module="mtpg.envs.mountaincar",
+    kernel_module="mtpg.envs.dynamics.mountaincar",
     step="step_discrete",
     observe="observe",
     sample_start="sample_start",
@@ -254,7 +255,7 @@ MOUNTAINCAR = TaskSpec(
 MOUNTAINCARCONTINUOUS = TaskSpec(
     name="MountainCarContinuous",
     short="MCC",
-    kernel_module="mtpg.envs.mountaincar",
+    kernel_module="mtpg.envs.dynamics.mountaincar",
     step="step_continuous",
     observe="observe",
     sample_start="sample_start",

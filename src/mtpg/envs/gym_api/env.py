@@ -1,7 +1,7 @@
 """A Gymnasium environment over the compiled kernels, one class for every task.
 
 ``gymnasium.make("mtpg/<Task>-v0")`` builds ``MtpgEnv(task=<id>)`` (see
-``mtpg.envs.registration``); ``gymnasium.make("mtpg/<Task>-v0", action="native")`` gives
+``mtpg.envs.gym_api.registration``); ``gymnasium.make("mtpg/<Task>-v0", action="native")`` gives
 the task's own single action instead of the paper's pair, for libraries that train on one
 ``Discrete`` or ``Box`` action. The environment uses exactly the kernels of the execution
 engine and the episode draws of ``make_episodes``: ``reset(seed=s)`` seeds the generator
@@ -22,12 +22,12 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from mtpg.envs.core import N_OBS, STATE_SIZE, STEP_SLOT
-from mtpg.envs.episodes import sample_start
-from mtpg.envs.kernels import env_observe, env_reset, env_step
-from mtpg.envs.task_table import REGISTERED, TaskTable
-from mtpg.envs.taskspec import TaskSpec
-from mtpg.envs.variants import obs_noise_sd, observation_bounds
+from mtpg.envs.dynamics.dispatch import env_observe, env_reset, env_step
+from mtpg.envs.specs.contract import N_OBS, STATE_SIZE, STEP_SLOT
+from mtpg.envs.specs.task_spec import TaskSpec
+from mtpg.envs.taskset.episodes import sample_start
+from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.variants import obs_noise_sd, observation_bounds
 
 #: The action interfaces: the paper's pair, or the task's own single action.
 ACTIONS: tuple[str, ...] = ("paper", "native")
@@ -72,7 +72,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
 
     Args:
         task: The task id (index into ``TASK_NAMES``), or a task or variant name
-            (``"CartPole[max_steps=500]"``, see :mod:`mtpg.envs.variants`).
+            (``"CartPole[max_steps=500]"``, see :mod:`mtpg.envs.taskset.variants`).
         render_mode: None or ``"rgb_array"``.
         action: ``"paper"`` or ``"native"``.
     """
@@ -175,7 +175,7 @@ class MtpgEnv(gym.Env[np.ndarray, tuple[int, np.ndarray]]):
             gym.logger.warn("render() called without a render_mode")
             return None
         if self._renderer is None:
-            from mtpg.envs.render import make_renderer
+            from mtpg.envs.gym_api.render import make_renderer
 
             self._renderer = make_renderer(self._spec)
         return self._renderer.frame(self._state, self._last_action)

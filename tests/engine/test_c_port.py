@@ -77,3 +77,30 @@ def test_every_pass_repeats_the_work_and_bad_passes_are_refused(tmp_path):
     assert outs[0] == outs[1]
     bad = subprocess.run([str(exe), str(data), str(tmp_path / "x"), "0"], capture_output=True)
     assert bad.returncode == 2 and b"PASSES" in bad.stderr
+
+
+@pytest.mark.parametrize("lanes", [1, 3, 32])
+@pytest.mark.parametrize(("teams", "programs", "instructions"), [(3, 10, 10), (6, 4, 30)])
+def test_lane_mode_equals_the_lane_engine_job_by_job(
+    port, tmp_path, lanes, teams, programs, instructions
+):
+    """The C lane yardstick plays each root's episodes in lockstep and changes no outcome."""
+    work = make_workload(30, teams, programs, instructions, episodes=8, seed=7)
+    engine = drive(work, 1, lanes).result
+    data = tmp_path / "w.bin"
+    c_port.write_input(work, data)
+    run = c_port.run_port(port, data, len(work.job_roots), lanes)
+    c_port.check(engine, run.result)
+    c_port.check(drive(work, 1, 0).result, run.result)  # and the scalar kernel's
+    assert np.any(engine.teams > engine.steps)
+
+
+def test_bad_lanes_are_refused(port, tmp_path):
+    import subprocess
+
+    work = make_workload(3, episodes=2, seed=3)
+    data = tmp_path / "w.bin"
+    c_port.write_input(work, data)
+    argv = [str(port), str(data), str(tmp_path / "x"), "1", "-2"]
+    bad = subprocess.run(argv, capture_output=True)
+    assert bad.returncode == 2 and b"LANES" in bad.stderr

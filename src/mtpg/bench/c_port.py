@@ -137,11 +137,15 @@ def write_input(work: Workload, path: Path) -> None:
             f.write(np.ascontiguousarray(a).tobytes())
 
 
-def run_port(exe: Path, input_path: Path, n_jobs: int) -> PortRun:
-    """Runs the C program on a written input and reads its outcomes."""
+def run_port(exe: Path, input_path: Path, n_jobs: int, lanes: int = 0) -> PortRun:
+    """Runs the C program on a written input and reads its outcomes.
+
+    ``lanes`` > 0 plays up to that many consecutive jobs of one root in lockstep (the
+    program's lane mode, the yardstick of the lane engine); 0 one job at a time.
+    """
     out_path = Path(input_path).with_suffix(".out")
     done = subprocess.run(
-        [str(exe), str(input_path), str(out_path), str(PASSES)],
+        [str(exe), str(input_path), str(out_path), str(PASSES), str(lanes)],
         capture_output=True,
         text=True,
         check=False,

@@ -231,7 +231,9 @@ def _same_result(a: BatchResult, b: BatchResult) -> bool:
     )
 
 
-def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, builds):
+def _c_runs(
+    work: Workload, engine: BatchResult, repeats: int, say, engine_run, builds, lanes: int = 0
+):
     """Times each C build interleaved with the engine: C, engine, C', engine, C, ...
 
     Every C run is paired with the one-thread engine run just after it, so each build's
@@ -244,6 +246,7 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, 
         say: Progress callback.
         engine_run: Runs the engine once on one thread (a ``DriveResult``).
         builds: Optimisation flag tuples, one C build each.
+        lanes: The C program's lane-block size (0: one job at a time), the engine's.
 
     Returns:
         ``{flags: (c_cpu_seconds, engine_cpu_seconds)}`` per repeat, or None without a
@@ -262,7 +265,7 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, 
             folder = Path(tmp) / f"build{k}"
             folder.mkdir()
             exes[flags] = c_port.build(folder, flags=flags)
-            first = c_port.run_port(exes[flags], data, len(work.job_roots))
+            first = c_port.run_port(exes[flags], data, len(work.job_roots), lanes)
             c_port.check(engine, first.result)
             say(
                 f"C port ({' '.join(flags)}): every job's return, steps, teams and instructions"
@@ -274,7 +277,7 @@ def _c_runs(work: Workload, engine: BatchResult, repeats: int, say, engine_run, 
         for r in range(repeats):
             for flags, exe in exes.items():
                 c_cpu, e_cpu = pairs[flags]
-                c_cpu.append(c_port.run_port(exe, data, len(work.job_roots)).cpu_seconds)
+                c_cpu.append(c_port.run_port(exe, data, len(work.job_roots), lanes).cpu_seconds)
                 e_cpu.append(engine_run().cpu_seconds)
                 say(
                     f"  pair {r + 1}/{repeats} ({' '.join(flags)}): C {c_cpu[-1]:.3f} s,"
@@ -334,7 +337,7 @@ def _time_c(
     c_flags = tuple(c_flags) if c_flags else C_FLAGS
     c_beside = C_FLAGS_BESIDE if c_beside is None else tuple(c_beside)
     builds = [c_flags] + ([c_beside] if c_beside and c_beside != c_flags else [])
-    return _c_runs(work, engine, repeats, say, lambda: drive(work, 1, lanes), builds)
+    return _c_runs(work, engine, repeats, say, lambda: drive(work, 1, lanes), builds, lanes)
 
 
 def _summary(work: Workload, runs: list, threads: int, ref: ReferenceRun | None, pt) -> dict:

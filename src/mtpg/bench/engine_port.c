@@ -13,7 +13,9 @@
  * by mtpg.bench.c_port.build), and the eight private registers of the common layout are
  * cleared by eight stores, not a memset call per program run.
  *
- * Usage: engine_port IN OUT [PASSES]. IN holds the compiled graph and the episodes (layout
+ * Usage: engine_port IN OUT [PASSES [LANES]]. LANES > 0 plays up to LANES consecutive jobs of
+ * one root in lockstep (play_all_lanes, the yardstick of the lane engine); 0, the default,
+ * one job at a time (play_all, the yardstick of the scalar kernel). IN holds the compiled graph and the episodes (layout
  * in mtpg.bench.c_port); OUT receives per-job returns, steps, teams and instructions of the
  * last pass. The job loop runs PASSES times (default 2); only the last is timed, so, like
  * the engine, it runs warm (code, input and heap pages touched). A timed pass allocates its
@@ -48,29 +50,30 @@ static double clamp(double v)
     return v;
 }
 
+/* Protected power (Table 2): |a|^b, 0 for a = 0, BIG past overflow, 0 past underflow. */
+static inline double op_pow(double a, double b)
+{
+    double x = fabs(a), e;
+    if (x == 0.0)
+        return 0.0;
+    e = b * log(x);
+    if (e > LOG_BIG)
+        return BIG;
+    if (e < LOG_TINY)
+        return 0.0;
+    return pow(x, b);
+}
+
 /* The protected operations of Table 2 and the engine's copy (mtpg.engine.ops.apply_op). */
 static double apply_op(uint32_t op, double d, double a, double b)
 {
-    double v, x, e;
+    double v;
     switch (op) {
     case 0: v = a + b; break;
     case 1: v = a - b; break;
     case 2: v = a * b; break;
     case 3: v = fabs(b) < DIV_EPS ? a : a / b; break;
-    case 4:
-        x = fabs(a);
-        if (x == 0.0) {
-            v = 0.0;
-        } else {
-            e = b * log(x);
-            if (e > LOG_BIG)
-                v = BIG;
-            else if (e < LOG_TINY)
-                v = 0.0;
-            else
-                v = pow(x, b);
-        }
-        break;
+    case 4: v = op_pow(a, b); break;
     case 5: v = cos(b); break;
     case 6: v = b == 0.0 ? 0.0 : log(fabs(b)); break;
     case 7: v = b > LOG_BIG ? BIG : exp(b); break;
@@ -239,17 +242,209 @@ static Outcome play_all(const Graph *g, int64_t n_teams, int64_t n_banks, int64_
     return o;
 }
 
+/* One operation over a lane group: D[l] = clamp(EXPR) for each lane l of grp, where a, b, d
+ * are the lane's operands (value v of lane l lives at W[v * L + l]). */
+#define OVER_GROUP(EXPR)                                                                     \
+    for (int64_t k = 0; k < ng; k++) {                                                       \
+        size_t l = (size_t)grp[k];                                                           \
+        double a = A[l], b = B[l], d = D[l];                                                 \
+        (void)a, (void)d;                                                                    \
+        D[l] = clamp(EXPR);                                                                  \
+    }                                                                                        \
+    break
+
+/* Lane mode (mtpg.engine.lanes' design, the C yardstick of `--lanes N`): up to L
+ * consecutive jobs of one root are played in lockstep. Each decision step, the live lanes
+ * at the same team form a group and every program of the team runs once over the group,
+ * one loop over the group's lanes per instruction, on a lane-contiguous workspace (value
+ * v of lane l at W[v * L + l]; the constants stored per lane, so one index rule serves
+ * every operand). Bids, the visited-team rule, lazy bank zeroing and the counts are per
+ * lane, as in the scalar mode, so every job's outcome is the same. */
+static Outcome play_all_lanes(const Graph *g, int64_t n_teams, int64_t n_banks, int64_t n_jobs,
+                              const int64_t *job_root, const int64_t *job_ep,
+                              const double *starts, const double *p, const double *constants,
+                              int64_t n_const, const double *folded, int64_t n_folded, int64_t L)
+{
+    Outcome o;
+    size_t Lz = (size_t)L, n_values = g->base + (size_t)n_banks * g->M;
+    double *W = calloc(n_values * Lz + 1, sizeof *W);
+    int64_t *visited = malloc(((size_t)n_teams * Lz + 1) * sizeof *visited);
+    int64_t *bank_job = malloc(((size_t)n_banks * Lz + 1) * sizeof *bank_job);
+    int64_t *lane = malloc(10 * Lz * sizeof *lane); /* the per-lane integer arrays below */
+    double *lane_f = malloc((4 + STATE_SIZE) * Lz * sizeof *lane_f);
+    o.returns = malloc(((size_t)n_jobs + 1) * sizeof *o.returns);
+    o.counts = malloc(3 * ((size_t)n_jobs + 1) * sizeof *o.counts);
+    if (!W || !visited || !bank_job || !lane || !lane_f || !o.returns || !o.counts) {
+        fprintf(stderr, "engine_port: out of memory\n");
+        exit(4);
+    }
+    int64_t *job = lane, *steps = lane + Lz, *n_team = lane + 2 * Lz, *n_ins = lane + 3 * Lz,
+            *live = lane + 4 * Lz, *at = lane + 5 * Lz, *pend = lane + 6 * Lz,
+            *grp = lane + 7 * Lz, *best_p = lane + 8 * Lz, *a_d = lane + 9 * Lz;
+    double *total = lane_f, *best = lane_f + Lz, *a_c = lane_f + 2 * Lz,
+           *S = lane_f + 4 * Lz; /* lane l's state at S + l * STATE_SIZE */
+    for (size_t i = 0; i < (size_t)n_teams * Lz; i++)
+        visited[i] = -1;
+    for (size_t i = 0; i < (size_t)n_banks * Lz; i++)
+        bank_job[i] = -1;
+    for (size_t l = 0; l < Lz; l++) {
+        for (int64_t c = 0; c < n_const; c++)
+            W[(g->R + (size_t)c) * Lz + l] = constants[c];
+        for (int64_t c = 0; c < n_folded; c++)
+            W[(g->base - (size_t)n_folded + (size_t)c) * Lz + l] = folded[c];
+    }
+    double *obs0 = W + (g->R + (size_t)n_const) * Lz, *obs1 = obs0 + Lz;
+    int64_t stamp = 0;
+    for (int64_t j0 = 0; j0 < n_jobs;) {
+        int64_t nl = 1, root = job_root[j0], n_live;
+        while (nl < L && j0 + nl < n_jobs && job_root[j0 + nl] == root)
+            nl++;
+        for (int64_t l = 0; l < nl; l++) {
+            double *s = S + l * STATE_SIZE;
+            job[l] = j0 + l;
+            memcpy(s, starts + job_ep[j0 + l] * STATE_SIZE, STATE_SIZE * sizeof *s);
+            s[PREV_FORCE] = p[FORCE];
+            s[STEP] = 0.0;
+            obs0[l] = clip_obs(s[0] / p[X_THRESHOLD]);
+            obs1[l] = clip_obs(s[2] / p[THETA_THRESHOLD]);
+            steps[l] = n_team[l] = n_ins[l] = 0;
+            total[l] = 0.0;
+            live[l] = l;
+        }
+        n_live = nl;
+        while (n_live > 0) {
+            int64_t n_pend = n_live;
+            stamp++;
+            for (int64_t k = 0; k < n_live; k++) {
+                pend[k] = live[k];
+                at[live[k]] = root;
+            }
+            while (n_pend > 0) { /* one group: the pending lanes at the first one's team */
+                int64_t team = at[pend[0]], ng = 0, keep = 0;
+                for (int64_t k = 0; k < n_pend; k++) {
+                    if (at[pend[k]] == team)
+                        grp[ng++] = pend[k];
+                    else
+                        pend[keep++] = pend[k];
+                }
+                n_pend = keep;
+                for (int64_t k = 0; k < ng; k++) {
+                    visited[team * L + grp[k]] = stamp;
+                    n_team[grp[k]]++;
+                    best_p[grp[k]] = -1;
+                }
+                for (int64_t m = g->team_offsets[team]; m < g->team_offsets[team + 1]; m++) {
+                    int64_t pr = g->team_members[m], bank = g->prog_bank[pr], act;
+                    size_t bank_v = g->base + (size_t)bank * g->M;
+                    for (int64_t k = 0; k < ng; k++) {
+                        size_t l = (size_t)grp[k];
+                        if (bank_job[(size_t)bank * Lz + l] != job[l]) {
+                            for (size_t i = 0; i < g->M; i++)
+                                W[(bank_v + i) * Lz + l] = 0.0;
+                            bank_job[(size_t)bank * Lz + l] = job[l];
+                        }
+                        for (size_t i = 0; i < g->R; i++)
+                            W[i * Lz + l] = 0.0;
+                    }
+                    for (int64_t i = g->prog_offsets[pr]; i < g->prog_offsets[pr + 1]; i++) {
+                        const uint32_t *in = g->instrs + 4 * i;
+                        double *D = W + (size_t)in[1] * Lz;
+                        const double *A = W + (size_t)in[2] * Lz, *B = W + (size_t)in[3] * Lz;
+                        switch (in[0]) {
+                        case 0: OVER_GROUP(a + b);
+                        case 1: OVER_GROUP(a - b);
+                        case 2: OVER_GROUP(a * b);
+                        case 3: OVER_GROUP(fabs(b) < DIV_EPS ? a : a / b);
+                        case 4: OVER_GROUP(op_pow(a, b));
+                        case 5: OVER_GROUP(cos(b));
+                        case 6: OVER_GROUP(b == 0.0 ? 0.0 : log(fabs(b)));
+                        case 7: OVER_GROUP(b > LOG_BIG ? BIG : exp(b));
+                        case 8: OVER_GROUP(sqrt(fabs(b)));
+                        case 9: OVER_GROUP(sin(b));
+                        case 10: OVER_GROUP(tanh(b));
+                        case 11: OVER_GROUP(b * b);
+                        case 12: OVER_GROUP(fabs(b));
+                        case 13: OVER_GROUP(b * b * b);
+                        case 14: OVER_GROUP(a < b ? -d : d);
+                        case 15: OVER_GROUP(a > b ? -d : d);
+                        default: /* OP_COPY of a folded constant: within [-BIG, BIG] already */
+                            for (int64_t k = 0; k < ng; k++)
+                                D[grp[k]] = B[grp[k]];
+                        }
+                    }
+                    act = g->prog_action[pr];
+                    for (int64_t k = 0; k < ng; k++) {
+                        int64_t l = grp[k];
+                        n_ins[l] += g->prog_count[pr];
+                        if ((act < 0 || visited[act * L + l] != stamp) &&
+                            (best_p[l] < 0 || W[l] > best[l])) {
+                            best[l] = W[l];
+                            best_p[l] = pr;
+                        }
+                    }
+                }
+                for (int64_t k = 0; k < ng; k++) {
+                    int64_t l = grp[k], act = g->prog_action[best_p[l]];
+                    if (act < 0) {
+                        size_t v = g->base + (size_t)g->prog_bank[best_p[l]] * g->M;
+                        a_c[l] = W[v * Lz + (size_t)l];
+                        a_d[l] = -1 - act;
+                    } else {
+                        at[l] = act;
+                        pend[n_pend++] = l;
+                    }
+                }
+            }
+            int64_t keep = 0;
+            for (int64_t k = 0; k < n_live; k++) { /* every live lane steps */
+                int64_t l = live[k];
+                double *s = S + l * STATE_SIZE;
+                int terminated, truncated;
+                (void)a_c[l]; /* CartPole reads the discrete action */
+                s[STEP] += 1.0;
+                terminated = cartpole_step(p, s, (int)a_d[l]);
+                truncated = !terminated && s[STEP] >= p[MAX_STEPS];
+                total[l] += 1.0;
+                steps[l]++;
+                if (terminated || truncated) {
+                    o.returns[job[l]] = total[l];
+                    o.counts[3 * job[l]] = steps[l];
+                    o.counts[3 * job[l] + 1] = n_team[l];
+                    o.counts[3 * job[l] + 2] = n_ins[l];
+                } else {
+                    obs0[l] = clip_obs(s[0] / p[X_THRESHOLD]);
+                    obs1[l] = clip_obs(s[2] / p[THETA_THRESHOLD]);
+                    live[keep++] = l;
+                }
+            }
+            n_live = keep;
+        }
+        j0 += nl;
+    }
+    free(W);
+    free(visited);
+    free(bank_job);
+    free(lane);
+    free(lane_f);
+    return o;
+}
+
 int main(int argc, char **argv)
 {
     int64_t h[N_HEADER];
     FILE *f;
     Graph g;
     struct timespec t0, t1;
-    if (argc != 3 && argc != 4) {
-        fprintf(stderr, "usage: %s IN OUT [PASSES]\n", argv[0]);
+    if (argc < 3 || argc > 5) {
+        fprintf(stderr, "usage: %s IN OUT [PASSES [LANES]]\n", argv[0]);
         return 2;
     }
-    long passes = argc == 4 ? strtol(argv[3], NULL, 10) : 2;
+    long passes = argc >= 4 ? strtol(argv[3], NULL, 10) : 2;
+    long lanes = argc == 5 ? strtol(argv[4], NULL, 10) : 0;
+    if (lanes < 0) {
+        fprintf(stderr, "engine_port: LANES must be at least 0\n");
+        return 2;
+    }
     if (passes < 1) {
         fprintf(stderr, "engine_port: PASSES must be at least 1\n");
         return 2;
@@ -290,8 +485,12 @@ int main(int argc, char **argv)
         free(o.returns);
         free(o.counts);
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t0);
-        o = play_all(&g, n_teams, h[7], n_jobs, job_root, job_ep, starts, p, constants, n_const,
-                     folded, h[12]);
+        if (lanes > 0)
+            o = play_all_lanes(&g, n_teams, h[7], n_jobs, job_root, job_ep, starts, p, constants,
+                               n_const, folded, h[12], lanes);
+        else
+            o = play_all(&g, n_teams, h[7], n_jobs, job_root, job_ep, starts, p, constants,
+                         n_const, folded, h[12]);
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t1);
     }
 

@@ -34,7 +34,7 @@ def _setup(n_graphs=60, seeds=(0, 1, 2)):
 def _args(cp, job_roots, job_eps, episodes):
     out = BatchResult.zeros(len(job_roots))
     table = episodes._replace(params=TASK_PARAMS)
-    return out, (Jobs(job_roots, job_eps), table, False, out, cp.graph)
+    return out, (Jobs(job_roots, job_eps), table, out, cp.graph)
 
 
 def test_serial_worker_takes_every_block_once():

@@ -25,7 +25,7 @@ cp = compile_population(pop)
 eps = Episodes.grid([0, 3], [0])
 roots = np.array([cp.team_index(r) for r in pop.roots()][:1] * 2, dtype=np.int64)
 out = BatchResult.zeros(2)
-run_lanes_queue(np.zeros(1, np.int64), 2, 4, Jobs(roots, np.arange(2)), eps, False, out, cp.graph)
+run_lanes_queue(np.zeros(1, np.int64), 2, 4, Jobs(roots, np.arange(2)), eps, out, cp.graph)
 (sig,) = run_lanes_queue.signatures
 asm = run_lanes_queue.inspect_asm(sig)
 print(json.dumps([len(asm), asm.lower().count("svml"), asm.count("cos")]))

@@ -148,3 +148,22 @@ def test_no_memory_mode_differs_only_by_memory():
             agent = ReferenceAgent(pop, root, no_memory=no_memory)
             total, _ = reference_episode(agent, 3, episodes.starts[0], episodes.noise[0])
             assert returns[i, 0] == total, (root, no_memory)
+
+
+def test_the_compiled_graph_carries_the_no_memory_mode():
+    """``compile_population(..., no_memory=True)`` plays as the deprecated argument does."""
+    rng = np.random.default_rng(5)
+    pop, roots = layered_graphs(rng, 30, teams=2, programs=6, instructions=10)
+    plain, ablated = compile_population(pop), compile_population(pop, no_memory=True)
+    assert not plain.no_memory and ablated.no_memory and ablated.graph.no_memory
+    assert ablated.with_memory_mode(None) is ablated
+    assert not ablated.with_memory_mode(False).no_memory
+    assert plain.graph.no_memory is False  # the flag itself untouched by the override
+    episodes = Episodes.grid([3], [0])  # Pendulum reads m[0] as its torque
+    passed, a = evaluate_roots(plain, roots, episodes, no_memory=True)
+    for lanes in (0, 4):
+        carried, b = evaluate_roots(ablated, roots, episodes, lanes=lanes)
+        assert carried.tobytes() == passed.tobytes()
+        assert np.array_equal(a.instructions, b.instructions)
+    on, _ = evaluate_roots(ablated, roots, episodes, no_memory=False)
+    assert on.tobytes() == evaluate_roots(plain, roots, episodes)[0].tobytes()

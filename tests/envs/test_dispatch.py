@@ -117,8 +117,8 @@ def test_an_id_without_a_branch_is_loud(graph):
     )  # fmt: skip
     jobs = Jobs(np.array([cp.team_index(root)]), np.zeros(1, np.int64))
     out = BatchResult.zeros(1)
-    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, False, out, cp.graph)
+    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, out, cp.graph)
     assert np.isnan(out.returns[0]) and out.steps[0] == 1
     rec = new_recorder(cp.graph, np.full(4, 1000), 200, False)  # traced: the same loop
-    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, False, out, cp.graph, rec)
+    run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, out, cp.graph, rec)
     assert np.isnan(rec.observations[0]).all() and np.isnan(rec.rewards[0])

@@ -190,10 +190,10 @@ def _run(config: RunConfig, generations: int, record: list | None = None):
     phase = ["train"]
     real = tr.evaluator.evaluate
 
-    def spy(cp, roots, table, no_memory):
+    def spy(cp, roots, table):
         if record is not None:
             record.append((phase[0], set(table.seeds.tolist())))
-        return real(cp, roots, table, no_memory)
+        return real(cp, roots, table)
 
     tr.evaluator.evaluate = spy
     rows, tests = [], []

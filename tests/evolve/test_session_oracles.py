@@ -187,7 +187,7 @@ def test_champion_tests_honour_the_memory_ablation(monkeypatch, no_memory: bool)
     real = evaluator_module.evaluate_roots
 
     def spy(*args, **kwargs):
-        seen.append(args[4] if len(args) > 4 else kwargs["no_memory"])
+        seen.append(args[0].no_memory)  # the compiled graph carries the ablation
         return real(*args, **kwargs)
 
     monkeypatch.setattr(evaluator_module, "evaluate_roots", spy)

@@ -109,7 +109,7 @@ def test_no_memory_flag_reaches_the_engine(monkeypatch):
     real = evaluator_module.evaluate_roots
 
     def spy(*args, **kwargs):
-        seen.append(args[4] if len(args) > 4 else kwargs["no_memory"])
+        seen.append(args[0].no_memory)  # the compiled graph carries the ablation
         return real(*args, **kwargs)
 
     monkeypatch.setattr(evaluator_module, "evaluate_roots", spy)

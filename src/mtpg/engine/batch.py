@@ -125,7 +125,7 @@ def run_jobs(
     job_episodes: np.ndarray,
     episodes: Episodes,
     threads: int = 1,
-    no_memory: bool = False,
+    no_memory: bool | None = None,
     block: int = 1,
     lanes: int = DEFAULT_LANES,
 ) -> BatchResult:
@@ -140,7 +140,9 @@ def run_jobs(
         job_episodes: int64 rows of ``episodes``, one per job.
         episodes: The episode table.
         threads: Numba threads to use (1: serial kernel, no thread pool).
-        no_memory: Zero each bank before every program execution (ablation).
+        no_memory: Deprecated: the ablation is ``cp``'s (``no_memory`` of
+            :func:`~mtpg.engine.compile.compile_population`). A bool overrides it for this
+            call; ``None`` keeps it.
         block: Jobs taken together from the queue by one thread (see
             ``run_jobs_queue``); the number of jobs per root keeps each root's episodes on
             one thread, in order. Results do not depend on it.
@@ -163,18 +165,18 @@ def run_jobs(
         np.ascontiguousarray(job_episodes, dtype=np.int64),
     )
     queue = np.zeros(1, dtype=np.int64)
-    g = cp.graph
+    g = cp.with_memory_mode(no_memory).graph
     if threads == 1 and lanes == 0:
-        run_jobs_queue(queue, block, jobs, episodes, no_memory, out, g)
+        run_jobs_queue(queue, block, jobs, episodes, out, g)
     elif threads == 1:
-        run_lanes_queue(queue, block, lanes, jobs, episodes, no_memory, out, g)
+        run_lanes_queue(queue, block, lanes, jobs, episodes, out, g)
     else:
         threads = min(threads, numba.config.NUMBA_NUM_THREADS)
         numba.set_num_threads(threads)
         if lanes == 0:
-            run_jobs_parallel(threads, queue, block, jobs, episodes, no_memory, out, g)
+            run_jobs_parallel(threads, queue, block, jobs, episodes, out, g)
         else:
-            run_lanes_parallel(threads, queue, block, lanes, jobs, episodes, no_memory, out, g)
+            run_lanes_parallel(threads, queue, block, lanes, jobs, episodes, out, g)
     return out
 
 
@@ -183,7 +185,7 @@ def evaluate_roots(
     root_ids: list[int],
     episodes: Episodes,
     threads: int = 1,
-    no_memory: bool = False,
+    no_memory: bool | None = None,
     lanes: int = DEFAULT_LANES,
 ) -> tuple[np.ndarray, BatchResult]:
     """Plays every episode of the table with every root.
@@ -193,7 +195,8 @@ def evaluate_roots(
         root_ids: Model ids of the teams to evaluate.
         episodes: The episode table.
         threads: Numba threads.
-        no_memory: Ablation switch, see :func:`run_jobs`.
+        no_memory: Deprecated pass-through, see :func:`run_jobs` (the ablation is a
+            property of ``cp``).
         lanes: Lane-block size, see :func:`run_jobs` (0: the scalar kernel).
 
     Returns:

@@ -22,7 +22,7 @@ uses (a fresh bank) can never be read or written, so it needs no workspace.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -63,6 +63,9 @@ class Graph(NamedTuple):
         n_registers: Private registers per program (``R``).
         n_memory: Registers per memory bank (``M``).
         mem_base: Workspace index of memory bank 0.
+        no_memory: The TPG-NoMemory ablation: every bank is zeroed before each program
+            execution. A property of the compiled graph, read once per decision by the
+            kernels (set by :func:`compile_population`).
     """
 
     team_offsets: np.ndarray
@@ -76,6 +79,7 @@ class Graph(NamedTuple):
     n_registers: int
     n_memory: int
     mem_base: int
+    no_memory: bool = False
 
 
 @dataclass(frozen=True)
@@ -99,6 +103,21 @@ class CompiledPopulation:
     bank_ids: np.ndarray
     n_instructions: np.ndarray
     folded: bool = False
+
+    @property
+    def no_memory(self) -> bool:
+        """Whether the graph runs with the no-memory ablation (:attr:`Graph.no_memory`)."""
+        return self.graph.no_memory
+
+    def with_memory_mode(self, no_memory: bool | None) -> CompiledPopulation:
+        """This compiled population in memory mode ``no_memory`` (the arrays are shared).
+
+        ``None`` keeps the compiled mode: the old ``no_memory=`` arguments of the run
+        functions pass through here (deprecated: compile with ``no_memory`` instead).
+        """
+        if no_memory is None or bool(no_memory) == self.graph.no_memory:
+            return self
+        return replace(self, graph=self.graph._replace(no_memory=bool(no_memory)))
 
     @property
     def mem_base(self) -> int:
@@ -165,7 +184,10 @@ def effective_code(prog: Program, layout: RegisterLayout) -> np.ndarray:
 
 
 def compile_population(
-    pop: Population, remove_introns: bool = True, fold_constants: bool = True
+    pop: Population,
+    remove_introns: bool = True,
+    fold_constants: bool = True,
+    no_memory: bool = False,
 ) -> CompiledPopulation:
     """Flattens a population for the kernels.
 
@@ -175,6 +197,8 @@ def compile_population(
         fold_constants: Fold instructions whose result is known before the program runs
             (:mod:`mtpg.engine.fold`; needs ``remove_introns``). Results are identical
             either way; the tracer needs the code unfolded.
+        no_memory: Compile for the no-memory ablation (every bank zeroed before each
+            program execution; :attr:`Graph.no_memory`).
 
     Returns:
         The compiled population.
@@ -232,6 +256,7 @@ def compile_population(
         n_registers=r,
         n_memory=m,
         mem_base=mem_base,
+        no_memory=bool(no_memory),
     )
     return CompiledPopulation(
         layout=layout,

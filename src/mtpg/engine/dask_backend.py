@@ -85,7 +85,6 @@ def play_batch(
     job_roots: np.ndarray,
     job_eps: np.ndarray,
     table: Episodes,
-    no_memory: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Plays one batch of jobs serially (runs on a worker).
 
@@ -94,8 +93,8 @@ def play_batch(
         job_roots: int64 dense team index of each job.
         job_eps: int64 episode row of each job.
         table: The episode table (the parameter table travels with the episodes,
-            variants' rows included).
-        no_memory: The memory ablation switch.
+            variants' rows included). The memory ablation is the graph's
+            (``graph.no_memory``).
 
     Returns:
         ``returns, steps, teams, instructions`` of the batch's jobs, in order.
@@ -104,9 +103,7 @@ def play_batch(
     queue = np.zeros(1, dtype=np.int64)
     jobs = Jobs(job_roots, job_eps)
     # one queue block: the batch's jobs in lane blocks of consecutive jobs (a root's episodes)
-    run_lanes_queue(
-        queue, max(len(job_roots), 1), DEFAULT_LANES, jobs, table, no_memory, out, graph
-    )
+    run_lanes_queue(queue, max(len(job_roots), 1), DEFAULT_LANES, jobs, table, out, graph)
     return out
 
 
@@ -248,16 +245,17 @@ class DaskEvaluator:
         cp: CompiledPopulation,
         root_ids: list[int],
         episodes: Episodes,
-        no_memory: bool = False,
+        no_memory: bool | None = None,
     ) -> tuple[np.ndarray, BatchResult]:
         """See :meth:`mtpg.engine.evaluator.Evaluator.evaluate`."""
+        cp = cp.with_memory_mode(no_memory)  # the deprecated override, if any
         if self.lost is not None:
-            return evaluate_roots(cp, root_ids, episodes, self.fallback_threads, no_memory)
+            return evaluate_roots(cp, root_ids, episodes, self.fallback_threads)
         roots = np.array([cp.team_index(r) for r in root_ids], dtype=np.int64)
         n_ep = len(episodes.tasks)
         for attempt in range(RESUBMITS + 1):
             try:
-                parts = self._map(cp, roots, episodes, no_memory)
+                parts = self._map(cp, roots, episodes)
                 break
             except Exception as exc:  # a cluster failure: retry, else local
                 if not _is_cluster_failure(exc):
@@ -266,7 +264,7 @@ class DaskEvaluator:
                     self.resubmits += 1
                     continue  # e.g. every copy of the inputs died with workers: send again
                 self.lost = f"{type(exc).__name__}: {exc}".strip().splitlines()[0]
-                return evaluate_roots(cp, root_ids, episodes, self.fallback_threads, no_memory)
+                return evaluate_roots(cp, root_ids, episodes, self.fallback_threads)
         n = len(roots) * n_ep
         result = BatchResult(
             np.zeros(n), np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n, np.int64)
@@ -281,7 +279,7 @@ class DaskEvaluator:
                 column.reshape(len(roots), n_ep)[b::n_batches] = values.reshape(-1, n_ep)
         return result.returns.reshape(len(roots), n_ep), result
 
-    def _map(self, cp, roots, episodes, no_memory) -> list:
+    def _map(self, cp, roots, episodes) -> list:
         n_ep = len(episodes.tasks)
         n_batches = plan_batches(len(roots), self.threads, self.min_roots)
         [graph] = self.client.scatter([graph_arrays(cp)], broadcast=True, hash=False)
@@ -297,7 +295,6 @@ class DaskEvaluator:
                     np.repeat(batch, n_ep),
                     np.tile(episode_rows, len(batch)),
                     table,
-                    no_memory,
                     pure=False,
                 )
             )

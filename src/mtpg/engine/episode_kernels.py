@@ -120,7 +120,7 @@ def thread_buffers(g) -> Buffers:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def decide(g, buf, root, stamp, episode, no_memory, rec):
+def decide(g, buf, root, stamp, episode, rec):
     """Makes one decision: traverses the graph from ``root`` to an atomic action.
 
     Written as one flat loop nest on purpose: helper functions taking arrays cost an
@@ -139,7 +139,6 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
         root: Dense index of the root team.
         stamp: This decision's mark (new per decision).
         episode: This episode's mark (new per episode: the lazy bank reset).
-        no_memory: Zero each bank before every program execution (ablation).
         rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` to log into.
 
     Returns:
@@ -148,6 +147,7 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
     team_offsets, team_members, prog_offsets = g.team_offsets, g.team_members, g.prog_offsets
     instrs, prog_action, prog_bank, prog_count = g.instrs, g.prog_action, g.prog_bank, g.prog_count
     R, M, base = g.n_registers, g.n_memory, g.mem_base
+    no_memory = g.no_memory  # the ablation: every bank zeroed before each program run
     W, team_stamp, bank_stamp, counts = buf.W, buf.team_stamp, buf.bank_stamp, buf.counts
     # Every index below is unsigned (np.uint64): Numba then emits plain loads and stores,
     # without the fix-up for negative (from-the-end) indices that a signed index costs at
@@ -209,7 +209,7 @@ def decide(g, buf, root, stamp, episode, no_memory, rec):
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
+def run_jobs_queue(next_block, block, jobs, table, out, g, rec=None):
     """One worker: takes blocks of jobs from a shared queue and plays them serially.
 
     Holds the package's one compiled episode loop: the batch kernels run it with
@@ -236,10 +236,10 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
             ``jobs.episodes[j]`` with root ``jobs.roots[j]``.
         table: :class:`~mtpg.engine.batch.Episodes`: task, start state and noise row of
             each episode, and the parameter table the task ids index.
-        no_memory: The no-memory ablation.
         out: :class:`~mtpg.engine.batch.BatchResult`: job ``j``'s return, steps, teams
             visited and instructions executed are written at ``j``.
-        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
+        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`; its ``no_memory``
+            field selects the ablation).
         rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` of a one-job run
             (which also ends where the episode's noise row ends, as a time limit that
             would read past it cannot occur in a table of ``make_episodes``).
@@ -272,7 +272,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
             while True:
                 if rec is not None:
                     record_observation(rec, t, obs)
-                a_d, a_c = decide(g, buf, root, stamp, j, no_memory, rec)
+                a_d, a_c = decide(g, buf, root, stamp, j, rec)
                 stamp += 1
                 if rec is not None:
                     record_decision(rec, t, a_d, a_c, buf, g, j)
@@ -296,7 +296,7 @@ def run_jobs_queue(next_block, block, jobs, table, no_memory, out, g, rec=None):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_jobs_parallel(n_workers, next_block, block, jobs, table, no_memory, out, g):
+def run_jobs_parallel(n_workers, next_block, block, jobs, table, out, g):
     """Runs all jobs on ``n_workers`` workers (one per Numba thread) sharing one queue.
 
     ``next_block`` is the queue's counter (int64 ``[1]``, 0 to start); once every job is
@@ -304,4 +304,4 @@ def run_jobs_parallel(n_workers, next_block, block, jobs, table, no_memory, out,
     the queue empty).
     """
     for _ in prange(n_workers):
-        run_jobs_queue(next_block, block, jobs, table, no_memory, out, g)
+        run_jobs_queue(next_block, block, jobs, table, out, g)

@@ -47,7 +47,7 @@ class Evaluator(Protocol):
         cp: CompiledPopulation,
         root_ids: list[int],
         episodes: Episodes,
-        no_memory: bool = False,
+        no_memory: bool | None = None,
     ) -> tuple[np.ndarray, BatchResult]:
         """Plays every episode of ``episodes`` with every root.
 
@@ -55,7 +55,8 @@ class Evaluator(Protocol):
             cp: The compiled population.
             root_ids: Model ids of the teams to evaluate.
             episodes: The episode table.
-            no_memory: Zero each bank before every program execution (ablation).
+            no_memory: Deprecated: the ablation is ``cp``'s (``no_memory`` of
+                :func:`~mtpg.engine.compile.compile_population`); a bool overrides it.
 
         Returns:
             ``returns`` float64 ``[n_roots, n_episodes]`` and the flat per-job result
@@ -89,7 +90,7 @@ class LocalEvaluator:
         cp: CompiledPopulation,
         root_ids: list[int],
         episodes: Episodes,
-        no_memory: bool = False,
+        no_memory: bool | None = None,
     ) -> tuple[np.ndarray, BatchResult]:
         """See :meth:`Evaluator.evaluate`."""
         return evaluate_roots(cp, root_ids, episodes, self.threads, no_memory)

@@ -67,7 +67,7 @@ DEFAULT_LANES = 32
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
-def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
+def run_lanes_queue(next_block, block, lanes, jobs, table, out, g):
     """One worker of the lane engine: takes blocks of jobs from a shared queue.
 
     The queue is :func:`~mtpg.engine.episode_kernels.run_jobs_queue`'s (block ``b`` is jobs
@@ -80,11 +80,12 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
         lanes: Jobs played in lockstep (the lane-block size, at least 1).
         jobs: :class:`~mtpg.engine.batch.Jobs`.
         table: :class:`~mtpg.engine.batch.Episodes`.
-        no_memory: The no-memory ablation.
         out: :class:`~mtpg.engine.batch.BatchResult`, written at each job's index.
-        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
+        g: The compiled graph (:class:`~mtpg.engine.compile.Graph`; its ``no_memory``
+            field selects the ablation).
     """
     R, M, base = g.n_registers, g.n_memory, g.mem_base
+    no_memory = g.no_memory
     n_teams = len(g.team_offsets) - 1
     n_progs = len(g.prog_offsets) - 1
     n_banks = (g.prog_bank.max() + 1) if n_progs else 0
@@ -303,7 +304,7 @@ def run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g):
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_lanes_parallel(n_workers, next_block, block, lanes, jobs, table, no_memory, out, g):
+def run_lanes_parallel(n_workers, next_block, block, lanes, jobs, table, out, g):
     """Runs all jobs on ``n_workers`` lane-engine workers sharing one queue."""
     for _ in prange(n_workers):
-        run_lanes_queue(next_block, block, lanes, jobs, table, no_memory, out, g)
+        run_lanes_queue(next_block, block, lanes, jobs, table, out, g)

@@ -32,7 +32,7 @@ from mtpg.engine.record import (
 
 
 @njit(cache=True, error_model="numpy")
-def trace_sequence_kernel(g, root, obs_seq, marks, no_memory, rec):
+def trace_sequence_kernel(g, root, obs_seq, marks, rec):
     """Decides for each row of ``obs_seq`` from ``root``, recording into ``rec``.
 
     ``marks[t]`` is the episode mark of step ``t`` (non-decreasing): a new mark starts a
@@ -47,7 +47,7 @@ def trace_sequence_kernel(g, root, obs_seq, marks, no_memory, rec):
         buf.obs[0] = obs_seq[t, 0]
         buf.obs[1] = obs_seq[t, 1]
         record_observation(rec, t, buf.obs)
-        a_d, a_c = decide(g, buf, root, t, marks[t], no_memory, rec)
+        a_d, a_c = decide(g, buf, root, t, marks[t], rec)
         record_decision(rec, t, a_d, a_c, buf, g, marks[t])
     return len(obs_seq)
 
@@ -114,7 +114,7 @@ def trace_sequence(
     cp: CompiledPopulation,
     root_id: int,
     observations: np.ndarray,
-    no_memory: bool = False,
+    no_memory: bool | None = None,
     snapshot: bool = True,
     episode_of_step: np.ndarray | None = None,
 ) -> Trace:
@@ -124,7 +124,7 @@ def trace_sequence(
         cp: The compiled population.
         root_id: Model id of the root team.
         observations: ``(n, 2)`` the input of each decision.
-        no_memory: The no-memory ablation.
+        no_memory: Deprecated: the ablation is ``cp``'s; a bool overrides it.
         snapshot: Record every bank after each decision.
         episode_of_step: Non-negative, non-decreasing episode marks, one per step (a new
             mark resets memory); default: one episode.
@@ -140,9 +140,10 @@ def trace_sequence(
     if len(marks) != len(obs) or np.any(np.diff(marks) < 0) or np.any(marks < 0):
         raise ValueError("episode_of_step must be non-negative, non-decreasing, one per step")
     root = cp.team_index(root_id)
+    g = cp.with_memory_mode(no_memory).graph
     rec, steps = record(
-        lambda rec: trace_sequence_kernel(cp.graph, root, obs, marks, no_memory, rec),
-        cp.graph,
+        lambda rec: trace_sequence_kernel(g, root, obs, marks, rec),
+        g,
         root,
         len(obs),
         snapshot,
@@ -156,7 +157,7 @@ def trace_episode(
     task: int,
     start: np.ndarray,
     noise: np.ndarray,
-    no_memory: bool = False,
+    no_memory: bool | None = None,
     snapshot: bool = False,
     obs_noise: np.ndarray | None = None,
     params: np.ndarray | None = None,
@@ -165,21 +166,23 @@ def trace_episode(
 
     ``obs_noise``: the episode's rows ``[T + 1, 2]``, for a variant with observation noise;
     ``params``: the parameter table ``task`` indexes (its task table's ``params``; the
-    registered tasks' by default).
+    registered tasks' by default). ``no_memory`` is deprecated: the ablation is ``cp``'s; a
+    bool overrides it.
     """
     _check_unfolded(cp)
+    g = cp.with_memory_mode(no_memory).graph
     root = cp.team_index(root_id)
     table = Episodes.single(task, start, noise, obs_noise, params)
     jobs = Jobs(np.array([root], dtype=np.int64), np.zeros(1, dtype=np.int64))
     out = BatchResult.zeros(1)
 
     def run(rec: Recorder) -> int:
-        run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, no_memory, out, cp.graph, rec)
+        run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, out, g, rec)
         return int(out.steps[0])
 
     rec, steps = record(
         run,
-        cp.graph,
+        g,
         root,
         table.noise.shape[1] - 1,
         snapshot,

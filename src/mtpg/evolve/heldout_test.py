@@ -23,9 +23,10 @@ from mtpg.envs.taskset.reference_scores import normalise, reference_of
 from mtpg.envs.taskset.task_table import REGISTERED, GivenReference, TaskTable
 from mtpg.model.graph import Population
 
-#: ``evaluate(compiled, roots, table, no_memory) -> (returns, result)``: how the episodes
-#: are played (this machine's threads, or a run's evaluation backend).
-Evaluate = Callable[[CompiledPopulation, list[int], Episodes, bool], tuple]
+#: ``evaluate(compiled, roots, table) -> (returns, result)``: how the episodes are played
+#: (this machine's threads, or a run's evaluation backend). The memory ablation is the
+#: compiled graph's (``compiled.no_memory``).
+Evaluate = Callable[[CompiledPopulation, list[int], Episodes], tuple]
 
 
 @dataclass(frozen=True)
@@ -59,8 +60,8 @@ class PlayedEpisodes:
 def local_evaluate(workers: int = 1) -> Evaluate:
     """Plays episodes on this machine's ``workers`` threads."""
 
-    def evaluate(cp, roots, table, no_memory):
-        return evaluate_roots(cp, roots, table, workers, no_memory)
+    def evaluate(cp, roots, table):
+        return evaluate_roots(cp, roots, table, workers)
 
     return evaluate
 
@@ -70,7 +71,7 @@ def play_episodes(
     roots: Sequence[int],
     task_ids: Sequence[int],
     seeds: np.ndarray,
-    no_memory: bool = False,
+    no_memory: bool | None = None,
     evaluate: Evaluate | None = None,
     table: TaskTable = REGISTERED,
 ) -> PlayedEpisodes:
@@ -81,17 +82,22 @@ def play_episodes(
         roots: Root team ids.
         task_ids: Task ids of ``table``.
         seeds: int64 episode seeds, the same for every task.
-        no_memory: Play with the no-memory ablation semantics.
+        no_memory: Play with the no-memory ablation semantics: how ``pop`` is compiled
+            (:func:`~mtpg.engine.compile.compile_population`). ``None``: a compiled
+            ``pop``'s own mode, memory on for a population.
         evaluate: How to play (default: one thread of this machine).
         table: The task table of the ids (the registered tasks by default).
 
     Returns:
         The measurements, ``[roots, tasks, episodes]``.
     """
-    cp = pop if isinstance(pop, CompiledPopulation) else compile_population(pop)
+    if isinstance(pop, CompiledPopulation):
+        cp = pop.with_memory_mode(no_memory)
+    else:
+        cp = compile_population(pop, no_memory=bool(no_memory))
     roots, task_ids = list(roots), list(task_ids)
     grid = Episodes.grid(task_ids, seeds, table)
-    returns, result = (evaluate or local_evaluate())(cp, roots, grid, no_memory)
+    returns, result = (evaluate or local_evaluate())(cp, roots, grid)
     shape = (len(roots), len(task_ids), len(seeds))
     return PlayedEpisodes(
         roots,
@@ -108,7 +114,7 @@ def play_test(
     task_ids: Sequence[int],
     episodes: int,
     seed: int = 0,
-    no_memory: bool = False,
+    no_memory: bool | None = None,
     evaluate: Evaluate | None = None,
     table: TaskTable = REGISTERED,
 ) -> PlayedEpisodes:

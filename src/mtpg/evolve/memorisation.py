@@ -257,15 +257,14 @@ def probe_graph(
     ids = [table.id_of(t) for t in tasks]
     train_seeds = np.asarray(train_seeds, dtype=np.int64)
     play = local_evaluate(workers)
-    cp = compile_population(pop)
+    cp = compile_population(pop, no_memory=no_memory)
     tables = (
         Episodes.grid(ids, train_seeds, table),
         fresh_noise_episodes(tasks, train_seeds, noise_seed, redraws, table),
         Episodes.grid(ids, held_out_seeds(test_episodes, test_offset), table),
     )
     train, fresh, test = (
-        np.asarray(play(cp, [root], table, no_memory)[0]).reshape(len(tasks), -1)
-        for table in tables
+        np.asarray(play(cp, [root], table)[0]).reshape(len(tasks), -1) for table in tables
     )
     per_redraw = fresh.reshape(len(tasks), redraws, len(train_seeds))
     return {

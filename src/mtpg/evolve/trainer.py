@@ -15,7 +15,7 @@ import numpy as np
 from mtpg._faults import point
 from mtpg.config import EvaluationConfig, RunConfig
 from mtpg.engine.batch import Episodes
-from mtpg.engine.compile import compile_population
+from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.evaluator import Evaluator
 from mtpg.envs.taskset.episode_seeds import resampled_training_seeds, validation_seeds
 from mtpg.evolve.backend import make_evaluator
@@ -170,6 +170,14 @@ class Trainer:
             self._block = (block, Episodes.grid(self.task_ids, seeds, self.tasks))
         return self._block[1]
 
+    def compile(self) -> CompiledPopulation:
+        """The population compiled for the kernels, in the run's memory mode.
+
+        The one place the ablation flag (``evaluation.no_memory``) flows from the config
+        into the compiled graph: every evaluation plays what this returns.
+        """
+        return compile_population(self.state.population, no_memory=self.config.evaluation.no_memory)
+
     def close(self) -> None:
         """Releases the evaluation backend (a Dask cluster started for the run)."""
         self.evaluator.close()
@@ -242,11 +250,10 @@ class Trainer:
         st, ev = self.state, self.config.evaluation
         roots = sorted(set(st.champions))
         test = play_test(
-            st.population,
+            self.compile(),
             roots,
             self.task_ids,
             ev.test_episodes,
-            no_memory=ev.no_memory,
             evaluate=self.evaluator.evaluate,
             table=self.tasks,
         )
@@ -295,10 +302,8 @@ class Trainer:
                 st.scores.clear()  # new episodes: every surviving root is scored again
             self._extra["reevaluated_roots"] = len(survivors)
         todo = [r for r in st.population.roots() if r not in st.scores]
-        cp = compile_population(st.population)
-        returns, result = self.evaluator.evaluate(
-            cp, todo, self.training_episodes(gen), ev.no_memory
-        )
+        cp = self.compile()
+        returns, result = self.evaluator.evaluate(cp, todo, self.training_episodes(gen))
         per_episode = returns.reshape(len(todo), len(self.task_ids), ev.train_episodes)
         for root, row in zip(todo, per_episode.mean(axis=2), strict=True):
             if ev.resample_mean and root in survivors:  # the mean over its blocks
@@ -351,8 +356,8 @@ class Trainer:
         todo = sorted({r for c in cands for r in c} - set(st.validation))
         decisions = 0
         if todo:
-            cp = compile_population(st.population)
-            returns, result = self.evaluator.evaluate(cp, todo, self.validation_table, ev.no_memory)
+            cp = self.compile()
+            returns, result = self.evaluator.evaluate(cp, todo, self.validation_table)
             n_ep = ev.validation_episodes
             means = returns.reshape(len(todo), len(self.task_ids), n_ep).mean(axis=2)
             for root, row in zip(todo, means, strict=True):

@@ -48,7 +48,7 @@ MIN_RUN_SECONDS = 0.3
 
 
 @njit(cache=True, error_model="numpy")
-def _engine_loop(g, root, obs, starts, no_memory, repeats):
+def _engine_loop(g, root, obs, starts, repeats):
     """Plays the stream ``repeats`` times with the engine's decision kernel; a checksum."""
     buf = thread_buffers(g)
     stamp = 0
@@ -60,7 +60,7 @@ def _engine_loop(g, root, obs, starts, no_memory, repeats):
                 episode += 1
             buf.obs[0] = obs[t, 0]
             buf.obs[1] = obs[t, 1]
-            a_d, a_c = decide(g, buf, root, stamp, episode, no_memory, None)
+            a_d, a_c = decide(g, buf, root, stamp, episode, None)
             stamp += 1
             checksum += a_d + a_c
     return checksum
@@ -118,13 +118,12 @@ def time_c(exe: Path, stream: Stream, runs: int) -> tuple[float, int]:
 
 def time_engine(pop: Population, root: int, stream: Stream, no_memory: bool, runs: int):
     """Fastest engine run in microseconds per decision, and the stream passes per run."""
-    cp = compile_population(pop)
+    cp = compile_population(pop, no_memory=no_memory)
     args = (
         cp.graph,
         cp.team_index(root),
         np.ascontiguousarray(stream.obs),
         np.ascontiguousarray(stream.starts),
-        no_memory,
     )
     _engine_loop(*args, 1)  # compile / load from cache
 

@@ -172,7 +172,8 @@ def engine_stream(
     """
     from mtpg.engine.batch import Episodes
 
-    cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
+    # the tracer logs programs as stated (unfolded); the ablation is the compiled graph's
+    cp = compile_population(pop, fold_constants=False, no_memory=no_memory)
     table = Episodes.grid(list(tasks), list(seeds), table)
     obs_rows, starts, actions, teams = [], [], [], []
     o = np.zeros(2)
@@ -184,7 +185,6 @@ def engine_stream(
             task,
             table.starts[e],
             table.noise[e],
-            no_memory=no_memory,
             obs_noise=eps,
             params=table.params,
         )

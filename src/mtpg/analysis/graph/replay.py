@@ -187,7 +187,8 @@ def replay_task(
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     table = TaskTable.from_names([task]) if table is None else table
     task_id = table.id_of(task)
-    cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
+    # the tracer logs programs as stated (unfolded); the ablation is the compiled graph's
+    cp = compile_population(pop, fold_constants=False, no_memory=no_memory)
     seeds = held_out_seeds(episodes, seed)
     starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds, table)
     n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
@@ -198,7 +199,6 @@ def replay_task(
             task_id,
             starts[e],
             noise[e],
-            no_memory=no_memory,
             snapshot=e < n_mem_eps,
             obs_noise=obs_noise[e] if obs_noise.shape[1] else None,
             params=table.params,
@@ -217,8 +217,9 @@ def replay_observations(
     No task runs: ``task`` is empty, ``task_id`` -1, hidden states and rewards are 0.
     Useful to probe a graph with inputs of one's own making.
     """
-    cp = compile_population(pop, fold_constants=False)  # the tracer logs programs as stated
-    trace = trace_sequence(cp, root, observations, no_memory=no_memory, snapshot=True)
+    # the tracer logs programs as stated (unfolded); the ablation is the compiled graph's
+    cp = compile_population(pop, fold_constants=False, no_memory=no_memory)
+    trace = trace_sequence(cp, root, observations, snapshot=True)
     header = {"task": "", "task_id": -1, "seed": 0, "episode_seeds": np.zeros(1, np.int64)}
     return _assemble(pop, root, cp, [trace], header, no_memory, 1)
 

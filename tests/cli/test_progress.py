@@ -138,3 +138,31 @@ def test_a_live_line_fits_the_terminal_width(monkeypatch):
     progress = Progress(10, tasks, stream=logged, live=False)
     progress(row)
     assert "teams/dec 1.90" in logged.getvalue()  # a log keeps the whole line
+
+
+def test_as_a_reporter_it_takes_the_test_scores_from_the_generation(tmp_path):
+    """No tests.csv is read: the test point's rows come with the generation."""
+    import io
+
+    from mtpg.cli.progress import Progress
+    from mtpg.evolve.reporters import Generation, Reporter
+
+    tasks = ("CartPole", "Acrobot")
+    row = {"generation": 4, "t_total": 1.0, "decisions_per_s": 1e6, "teams_per_decision": 1.5}
+    row.update({f"best_{t}": 1.0 for t in tasks})
+    tests = [
+        {"generation": 4, "subset": "CartPole", "test_CartPole": 50.0},
+        {
+            "generation": 4,
+            "subset": "CartPole+Acrobot",
+            "test_CartPole": 12.5,
+            "test_Acrobot": -99.0,
+        },
+    ]
+    out = io.StringIO()
+    progress = Progress(10, tasks, stream=out, live=False, tests_file=tmp_path / "absent.csv")
+    assert isinstance(progress, Reporter)
+    progress.generation(Generation(4, row, tests), None)
+    assert "test@4 CP 12.5 AB -99" in out.getvalue()
+    progress.generation(Generation(5, {**row, "generation": 5}, None), None)
+    assert out.getvalue().splitlines()[-1].count("test@4") == 1  # kept until the next point

@@ -141,7 +141,9 @@ def _train(args: argparse.Namespace) -> int:
         try:
             # a signal stops at the next boundary; so does a lost cluster (run_all raises
             # BackendLost once the last generation is committed)
-            finished = session.run_all(progress, stop.requested, extra)
+            # the progress display is the last reporter: it shows what the others committed
+            shown = [*extra, progress] if progress is not None else extra
+            finished = session.run_all(None, stop.requested, shown)
         except BackendLost as exc:
             lost, finished = exc, False
         except StopNow as exc:

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import TextIO
 
 from mtpg.envs.specs.registry import TASKS
+from mtpg.evolve.reporters import Generation, Reporter
 
 #: Short task labels for the status line (the header spells them out): each spec's
 #: ``short``.
@@ -76,8 +77,21 @@ def last_test(tests_file: Path | None, subset: str) -> tuple[int, dict[str, floa
     return int(float(found["generation"])), scores
 
 
-class Progress:
+def champion_test(rows: list[dict], subset: str) -> tuple[int, dict[str, float]] | None:
+    """The test point's row of ``subset`` among a generation's rows: as :func:`last_test`."""
+    for row in rows:
+        if row.get("subset") == subset:
+            scores = {k[5:]: float(v) for k, v in row.items() if k.startswith("test_")}
+            return int(float(row["generation"])), scores
+    return None
+
+
+class Progress(Reporter):
     """Reports each generation of a training run.
+
+    A :class:`~mtpg.evolve.reporters.Reporter`: given to the run with its other reporters,
+    it reads each test point's scores from the generation itself. Called as a function
+    with a metrics row (the older form), it reads them back from ``tests_file``.
 
     Args:
         total: The run's last generation.
@@ -104,12 +118,12 @@ class Progress:
         self.short = short_names(tasks)
         self.stream = stream or sys.stderr
         self.live = self.stream.isatty() if live is None else live
-        self.start = time.perf_counter()
+        self._started = time.perf_counter()
         self.tests_file = tests_file
         self.train_episodes = train_episodes
         self.test_episodes = test_episodes
         self.test: tuple[int, dict[str, float]] | None = None
-        self._last = self.start
+        self._last = self._started
         self._durations: list[float] = []
         self._header_done = False
 
@@ -214,14 +228,24 @@ class Progress:
             f"teams/dec {row['teams_per_decision']:.2f}"
         )
 
+    def generation(self, gen: Generation, trainer: object = None) -> None:
+        """Shows one generation (the reporter form): its test scores come with it."""
+        if gen.tests:
+            self.test = champion_test(gen.tests, "+".join(self.tasks)) or self.test
+        self.show(gen.metrics)
+
     def __call__(self, row: dict[str, float], _trainer: object = None) -> None:
-        """Shows one generation."""
+        """Shows one generation from its metrics row, reading a test point's scores back."""
+        if row.get("t_test", 0.0) > 0 or int(row["generation"]) >= self.total:
+            self.test = last_test(self.tests_file, "+".join(self.tasks)) or self.test
+        self.show(row)
+
+    def show(self, row: dict[str, float]) -> None:
+        """Writes the status line of one metrics row."""
         now = time.perf_counter()
         self._durations.append(now - self._last)
         self._last = now
         self._write_header()
-        if row.get("t_test", 0.0) > 0 or int(row["generation"]) >= self.total:
-            self.test = last_test(self.tests_file, "+".join(self.tasks)) or self.test
         text = self.line(row)
         if self.live:
             self.stream.write("\r\x1b[2K" + self._fit(text))

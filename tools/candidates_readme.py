@@ -34,6 +34,8 @@ BEGIN, END = "<!-- candidates table: begin -->", "<!-- candidates table: end -->
 
 def finished(run: Path) -> bool:
     """Whether the run has reached the generations of its configuration."""
+    if not (run / "config.toml").is_file():
+        return False
     target = tomllib.loads((run / "config.toml").read_text())["generations"]
     lines = (run / "metrics.csv").read_text().splitlines()
     return len(lines) > 1 and int(lines[-1].split(",")[0]) >= target

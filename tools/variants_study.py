@@ -21,12 +21,12 @@ signature of CartCentering played as MountainCar. The figures go to
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
-import tomllib
 from pathlib import Path
 
 import numpy as np
+from candidates_readme import EPISODES, finished
+from candidates_readme import scores as run_scores
 
 from mtpg.analysis.plotting import pyplot, save
 from mtpg.analysis.runs.champions import run_champion
@@ -50,29 +50,12 @@ GROUPS = {
     "six tasks, authors' code": (FOLDER / "runs", "six-authors-seed"),
 }
 SEEDS = (1, 2, 3)
-EPISODES = 100
 BEGIN, END = "<!-- variants table: begin -->", "<!-- variants table: end -->"
-
-
-def finished(run: Path) -> bool:
-    """Whether the run has reached the generations of its configuration."""
-    if not (run / "config.toml").is_file():
-        return False
-    target = tomllib.loads((run / "config.toml").read_text())["generations"]
-    lines = (run / "metrics.csv").read_text().splitlines()
-    return len(lines) > 1 and int(lines[-1].split(",")[0]) >= target
 
 
 def scores(run: Path) -> dict[str, float]:
     """The all-task champion's normalised score per task (base names) on held-out episodes."""
-    out = subprocess.run(
-        [sys.executable, "-m", "mtpg", "evaluate", str(run), "--episodes", str(EPISODES)]
-        + ["--json"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout
-    return {task.split("[")[0]: row["normalised"] for task, row in json.loads(out).items()}
+    return {task.split("[")[0]: value for task, value in run_scores(run).items()}
 
 
 def off_track(run: Path) -> tuple[float, float]:

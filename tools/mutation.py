@@ -53,7 +53,7 @@ MODULES: dict[str, tuple[list[str], list[str]]] = {
         ["tests/evolve", "tests/io/test_io_checkpoint.py"],
     ),
     "config": (
-        ["src/mtpg/config.py"],
+        ["src/mtpg/config/sections.py", "src/mtpg/config/resolve.py"],
         ["tests/test_config.py", "tests/evolve/test_selection_oracles.py"],
     ),
     "io": (["src/mtpg/io/*"], ["tests/io"]),
@@ -367,7 +367,7 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     ),
     HandMutant(
         "bug-min-elite-rounds-down",
-        "src/mtpg/config.py",
+        "src/mtpg/config/sections.py",
         "-(-self.team.min_elite_total // n)",
         "self.team.min_elite_total // n",
         ("tests/evolve/test_selection_oracles.py", "tests/test_config.py"),

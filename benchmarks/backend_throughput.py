@@ -24,7 +24,8 @@ import platform
 import statistics
 
 from mtpg.config import build_config
-from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
+from mtpg.evolve.columns import TIMING_COLUMNS
+from mtpg.evolve.trainer import Trainer
 
 
 def tree_cpu() -> float:

@@ -30,7 +30,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from mtpg.evolve.trainer import TIMING_COLUMNS
+from mtpg.evolve.columns import TIMING_COLUMNS
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMING = tuple(TIMING_COLUMNS)

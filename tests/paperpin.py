@@ -53,7 +53,7 @@ def mtpg(*args: str) -> subprocess.CompletedProcess:
 
 def metrics_without_timing(path: Path) -> list[list[str]]:
     """The rows of a ``metrics.csv``, timing columns removed."""
-    from mtpg.evolve.trainer import TIMING_COLUMNS
+    from mtpg.evolve.columns import TIMING_COLUMNS
 
     rows = list(csv.reader(io.StringIO(path.read_text())))
     keep = [i for i, c in enumerate(rows[0]) if c not in TIMING_COLUMNS]

@@ -9,7 +9,7 @@ import sys
 import time
 from pathlib import Path
 
-from mtpg.evolve.trainer import TIMING_COLUMNS
+from mtpg.evolve.columns import TIMING_COLUMNS
 from tinyruns import tiny_args
 
 #: Settings of a tiny run with a test point every 2 generations and a commit every 3.

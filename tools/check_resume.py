@@ -35,7 +35,7 @@ import tomllib
 from datetime import UTC, datetime
 from pathlib import Path
 
-from mtpg.evolve.trainer import TIMING_COLUMNS
+from mtpg.evolve.columns import TIMING_COLUMNS
 
 
 def git(repo: Path, *args: str) -> str:

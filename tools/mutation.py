@@ -53,7 +53,7 @@ MODULES: dict[str, tuple[list[str], list[str]]] = {
         ["tests/evolve", "tests/io/test_io_checkpoint.py"],
     ),
     "config": (
-        ["src/mtpg/config.py"],
+        ["src/mtpg/config/sections.py", "src/mtpg/config/resolve.py"],
         ["tests/test_config.py", "tests/evolve/test_selection_oracles.py"],
     ),
     "io": (["src/mtpg/io/*"], ["tests/io"]),
@@ -304,15 +304,15 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "div-threshold",
         "src/mtpg/engine/ops.py",
-        "v = a if abs(b) < DIV_EPS else a / b",
-        "v = a if abs(b) < 1e-9 else a / b",
+        "return a if abs(b) < DIV_EPS else a / b",
+        "return a if abs(b) < 1e-9 else a / b",
         _OPS,
     ),
     HandMutant(
         "div-threshold-inclusive",
         "src/mtpg/engine/ops.py",
-        "v = a if abs(b) < DIV_EPS else a / b",
-        "v = a if abs(b) <= DIV_EPS else a / b",
+        "return a if abs(b) < DIV_EPS else a / b",
+        "return a if abs(b) <= DIV_EPS else a / b",
         _OPS,
     ),
     HandMutant(
@@ -332,15 +332,15 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "exp-cap-inclusive",
         "src/mtpg/engine/ops.py",
-        "v = BIG if b > LOG_BIG else math.exp(b)",
-        "v = BIG if b >= LOG_BIG - 1e-6 else math.exp(b)",
+        "    if b > LOG_BIG:\n        return BIG",
+        "    if b >= LOG_BIG - 1e-6:\n        return BIG",
         _OPS,
     ),
     HandMutant(
         "ln-zero-guard",
         "src/mtpg/engine/ops.py",
-        "v = 0.0 if b == 0.0 else math.log(abs(b))",
-        "v = -BIG if b == 0.0 else math.log(abs(b))",
+        "return 0.0 if b == 0.0 else math.log(abs(b))",
+        "return -BIG if b == 0.0 else math.log(abs(b))",
         _OPS,
     ),
     HandMutant(
@@ -367,7 +367,7 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     ),
     HandMutant(
         "bug-min-elite-rounds-down",
-        "src/mtpg/config.py",
+        "src/mtpg/config/sections.py",
         "-(-self.team.min_elite_total // n)",
         "self.team.min_elite_total // n",
         ("tests/evolve/test_selection_oracles.py", "tests/test_config.py"),
@@ -376,8 +376,8 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "kernel-tie-to-later-program",
         "src/mtpg/engine/episode_kernels.py",
-        "(not found or bid > best)",
-        "(not found or bid >= best)",
+        "(best_p < 0 or bid > best)",
+        "(best_p < 0 or bid >= best)",
         _ENGINE,
     ),
     HandMutant(
@@ -396,17 +396,17 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     ),
     HandMutant(
         "kernel-time-limit-one-late",
-        "src/mtpg/engine/episode_kernels.py",
+        "src/mtpg/envs/dynamics/dispatch.py",
         "truncated = (not terminated) and state[STEP_SLOT] >= p[P_MAX_STEPS]",
         "truncated = (not terminated) and state[STEP_SLOT] > p[P_MAX_STEPS]",
         _ENGINE,
     ),
     HandMutant(
         "kernel-dispatch-swaps-tasks",
-        "src/mtpg/engine/episode_kernels.py",
+        "src/mtpg/envs/dynamics/dispatch.py",
         "reward, terminated = mountaincar.step_discrete(p, state, a_d)",
         "reward, terminated = mountaincar.step_continuous(p, state, a_c)",
-        _ENGINE,
+        ("tests/envs/test_dispatch.py", "tests/envs/test_gym_parity.py"),
     ),
     # the batch kernel's job queue (every block taken exactly once)
     HandMutant(
@@ -427,8 +427,8 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "kernel-continuous-output-register",
         "src/mtpg/engine/episode_kernels.py",
-        "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m]",
-        "return -1 - act, W[u_base + np.uint64(prog_bank[best_p]) * u_m + one]",
+        "return -1 - act, W[u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m]",
+        "return -1 - act, W[u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m + np.uint64(1)]",
         _ENGINE,
     ),
     # the paper's selection rule (section 4.1) and the validated champion choice

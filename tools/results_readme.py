@@ -26,7 +26,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 from grow_results import KEEP_TESTS_EVERY
-from results_text import (  # the tool's own helper module beside it
+from results_text import (  # the tool's own helper modules beside it
     GOOD,
     LEVEL,
     PAPER,
@@ -39,6 +39,8 @@ from results_text import (  # the tool's own helper module beside it
     resume_check_rows,
     status_rows,
 )
+from robust_section import is_robust
+from robust_section import section as robust_section
 
 TARGET = 1000
 GROWING = [
@@ -88,8 +90,15 @@ def _fig(name: str, caption: str) -> str:
     return f"![{caption}](figures/{name})\n\n*{caption}*\n"
 
 
-def build(results: Path, analyze: bool = True) -> Path:
-    """Writes the figures and ``README.md`` of ``results``; returns the README's path."""
+def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
+    """Writes the figures and ``README.md`` of ``results``; returns the README's path.
+
+    The TPG-robust runs (``TPG-robust-seedN``) are listed with the others (status,
+    re-scores, cost) and compared with TPG in a section of their own
+    (:mod:`robust_section`); the paper's experiment (figures, summaries, ablations) is of
+    the other runs. ``probe`` adds the memorisation probe of every TPG and TPG-robust
+    final champion to that section.
+    """
     from mtpg.analysis.runs.champions import CHAMPION_RULE
     from mtpg.analysis.runs.loading import group_runs, load_run
     from mtpg.analysis.runs.report import build_report
@@ -101,8 +110,11 @@ def build(results: Path, analyze: bool = True) -> Path:
     )
     from mtpg.analysis.runs.statistics_figures import STATS_NOTE, group_estimates
 
-    paths = _runs(results)
-    runs = [load_run(p) for p in paths]
+    every = [load_run(p) for p in _runs(results)]
+    robust = [dataclasses.replace(r, label="TPG-robust") for r in every if is_robust(r.path)]
+    every = [r for r in every if not is_robust(r.path)] + robust  # TPG-robust listed last
+    runs = [r for r in every if not is_robust(r.path)]  # the paper's experiment
+    paths = [r.path for r in runs]
     groups, _ = group_runs(runs)
     numbers = {r.path: run_numbers(r) for r in runs}
     tasks = runs[0].tasks
@@ -133,12 +145,25 @@ def build(results: Path, analyze: bool = True) -> Path:
         "`tools/grow_results.py` and committed with its last checkpoint, so that "
         "`mtpg train --resume results/runs/RUN` continues any of them exactly. This page "
         "and its figures are written by `.venv/bin/python tools/results_readme.py` from "
-        "the committed files alone.",
+        "the committed files alone."
+        + (
+            " Beside them, five runs of TPG-robust (the `robust` preset), compared with "
+            "TPG in their own section below."
+            if robust
+            else ""
+        ),
         "",
         "## Status",
         "",
     ]
     done = len(at_target) == len(runs)
+    if done and any(r.final_generation < TARGET for r in robust):
+        lines += [
+            "**TPG-robust in progress**: the paper's experiment below is complete; the "
+            "TPG-robust runs are still growing, and their section compares both groups at "
+            "the TPG-robust runs' latest common test point.",
+            "",
+        ]
     if not done:
         lines += [
             "**In progress**: not every run has reached generation 1,000, so every figure "
@@ -146,7 +171,7 @@ def build(results: Path, analyze: bool = True) -> Path:
             "not of the paper's 1,000 generations.",
             "",
         ]
-    lines += markdown_table(*status_rows(runs, TARGET)) + [""]
+    lines += markdown_table(*status_rows(every, TARGET)) + [""]
     if partial:
         lines += [
             f"Figures and summaries (best run, interquartile means, best single-task "
@@ -189,7 +214,7 @@ def build(results: Path, analyze: bool = True) -> Path:
     rows.append([f"IQM over TPG seeds{at}", "", *(e.text(2) for e in per_task)])
     lines += markdown_table(head, rows)
     lines += ["", f"IQM over TPG seeds{at} and all tasks: {overall.text(2)}.", ""]
-    head, rows, agree, cells = rescore_rows(runs)
+    head, rows, agree, cells = rescore_rows(every)
     lines += [
         "Every run's all-task champion: mean test return ± the half-width of its 95% "
         f"confidence interval (1.96 std / sqrt(n), n = {runs[0].test_episodes} test "
@@ -261,6 +286,13 @@ def build(results: Path, analyze: bool = True) -> Path:
             "",
         ]
         lines += [f"![{p.stem}](analysis/{p.name})\n" for p in pngs]
+    if robust:
+        probes = {}
+        if probe:
+            from mtpg.analysis.runs.memorisation import probe_target
+
+            probes = {r.name: probe_target(r.path) for r in [*tpg.runs, *robust]}
+        lines += robust_section(tpg.runs, robust, best_single, probes, TARGET)
     lines += ["## Cost", ""]
     lines += [
         "Wall-clock hours: the sum of `metrics.csv`'s `t_total` (every generation, test "
@@ -271,7 +303,7 @@ def build(results: Path, analyze: bool = True) -> Path:
         "quiet machine needs (the processor is in each run's `provenance.csv`).",
         "",
     ]
-    lines += markdown_table(*cost_rows(runs)) + [""]
+    lines += markdown_table(*cost_rows(every)) + [""]
     lines += GROWING
     checked = results / "resume_check.csv"
     if checked.is_file():
@@ -305,8 +337,9 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--results", type=Path, default=Path("results"), help="folder (results)")
     p.add_argument("--no-analyze", action="store_true", help="skip the section-6 figures")
+    p.add_argument("--no-probe", action="store_true", help="skip TPG-robust's probe table")
     args = p.parse_args(argv)
-    print(build(args.results, analyze=not args.no_analyze))
+    print(build(args.results, analyze=not args.no_analyze, probe=not args.no_probe))
     return 0
 
 

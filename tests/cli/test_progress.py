@@ -145,7 +145,7 @@ def test_as_a_reporter_it_takes_the_test_scores_from_the_generation(tmp_path):
     import io
 
     from mtpg.cli.progress import Progress
-    from mtpg.evolve.reporters import Generation, Reporter
+    from mtpg.evolve.trainer import Generation, Reporter
 
     tasks = ("CartPole", "Acrobot")
     row = {"generation": 4, "t_total": 1.0, "decisions_per_s": 1e6, "teams_per_decision": 1.5}

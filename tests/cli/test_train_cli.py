@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from mtpg.cli.main import main
-from mtpg.evolve.trainer import TIMING_COLUMNS
+from mtpg.evolve.columns import TIMING_COLUMNS
 from tinyruns import tiny_args
 
 TINY = tiny_args("CartPole,MountainCar", root_size=20, n_elite=3)

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from mtpg.cli.main import main
-from mtpg.evolve.trainer import TIMING_COLUMNS
+from mtpg.evolve.columns import TIMING_COLUMNS
 from tinyruns import tiny_args
 
 TASKS = "CartPole[max_steps=500],Pendulum[observe=theta;max_steps=60;noise=0.1]"

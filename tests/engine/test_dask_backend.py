@@ -14,7 +14,8 @@ from mtpg.engine.compile import compile_population
 from mtpg.engine.dask_backend import DaskEvaluator, plan_batches
 from mtpg.engine.workload import tangled_population
 from mtpg.envs.taskset.task_table import TaskTable
-from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
+from mtpg.evolve.columns import TIMING_COLUMNS
+from mtpg.evolve.trainer import Trainer
 
 TINY = [
     "team.root_size=30",

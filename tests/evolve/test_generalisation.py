@@ -21,7 +21,7 @@ from mtpg.envs.taskset.episode_seeds import (
 )
 from mtpg.envs.taskset.reference_scores import REFERENCE
 from mtpg.evolve import heldout_test as heldout_test_module
-from mtpg.evolve import trainer as trainer_module
+from mtpg.evolve.columns import TIMING_COLUMNS, metric_columns
 from mtpg.evolve.persist import (
     config_differences,
     identity_fields,
@@ -30,7 +30,7 @@ from mtpg.evolve.persist import (
     state_to_payload,
 )
 from mtpg.evolve.selection import candidates, rankings
-from mtpg.evolve.trainer import Trainer, metric_columns
+from mtpg.evolve.trainer import Trainer
 from mtpg.evolve.validation import choose, validation_fitness
 
 TINY = [
@@ -287,7 +287,7 @@ def test_a_run_continued_from_its_payload_equals_the_uninterrupted_one(options) 
     second = Trainer(config, state)
     again = [second.run_generation() for _ in range(2)]
     assert _state(second) == _state(whole)
-    timing = trainer_module.TIMING_COLUMNS
+    timing = TIMING_COLUMNS
     strip = [{k: v for k, v in r.items() if k not in timing} for r in again]
     assert strip == [{k: v for k, v in r.items() if k not in timing} for r in rows[3:]]
     first.close()

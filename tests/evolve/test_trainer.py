@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from mtpg.config import build_config
+from mtpg.evolve.columns import TIMING_COLUMNS
 from mtpg.evolve.session import Session
-from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
+from mtpg.evolve.trainer import Trainer
 from mtpg.model.graph import check_invariants
 
 TINY = [

@@ -293,6 +293,7 @@ def test_variation_draws_new_instructions_in_blocks(monkeypatch) -> None:
 def test_metrics_row_from_a_hand_made_result(seed: int) -> None:
     from types import SimpleNamespace
 
+    from mtpg.evolve.columns import metrics_row
     from mtpg.evolve.trainer import Trainer
 
     cfg = build_config(
@@ -313,7 +314,15 @@ def test_metrics_row_from_a_hand_made_result(seed: int) -> None:
         prog.bank = min(pop.memory_banks)  # a single bank in use
     scores = np.array([trainer.state.scores[r] for r in sorted(trainer.state.scores)])
     result = SimpleNamespace(steps=np.array([1]), teams=np.array([3]), instructions=np.array([7]))
-    row = trainer._metrics([1, 2], result, (10.0, 11.0, 11.5, 12.0))
+    st = trainer.state
+
+    def metrics(new_roots, result, times):
+        names = trainer.tasks.names
+        return metrics_row(
+            st.generation, pop, st.scores, st.champions[-1], names, new_roots, result, {}, times
+        )
+
+    row = metrics([1, 2], result, (10.0, 11.0, 11.5, 12.0))
     assert row["programs_per_bank"] == len(pop.programs)
     assert row["decisions"] == 1 and row["new_roots"] == 2
     assert row["teams_per_decision"] == 3.0 and row["instructions_per_decision"] == 7.0
@@ -326,9 +335,9 @@ def test_metrics_row_from_a_hand_made_result(seed: int) -> None:
     four = SimpleNamespace(
         steps=np.array([2, 2]), teams=np.array([6, 6]), instructions=np.array([14, 14])
     )
-    row = trainer._metrics([1, 2], four, (10.0, 11.0, 13.0, 14.0))
+    row = metrics([1, 2], four, (10.0, 11.0, 13.0, 14.0))
     assert row["decisions"] == 4 and row["decisions_per_s"] == 2.0
     assert row["teams_per_decision"] == 3.0 and row["instructions_per_decision"] == 7.0
     none = SimpleNamespace(steps=np.array([0]), teams=np.array([0]), instructions=np.array([0]))
-    row = trainer._metrics([], none, (0.0, 1.0, 1.0, 1.0))
+    row = metrics([], none, (0.0, 1.0, 1.0, 1.0))
     assert row["teams_per_decision"] == 0.0 and row["decisions_per_s"] == 0.0

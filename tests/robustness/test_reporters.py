@@ -3,9 +3,10 @@
 import pytest
 
 from mtpg.config import build_config
+from mtpg.evolve.columns import TIMING_COLUMNS
 from mtpg.evolve.reporters import CallbackReporter, Reporter, generations, train
 from mtpg.evolve.session import Session
-from mtpg.evolve.trainer import TIMING_COLUMNS, Trainer
+from mtpg.evolve.trainer import Trainer
 
 SETTINGS = [
     "team.root_size=12",

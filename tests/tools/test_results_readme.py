@@ -149,3 +149,50 @@ def test_the_paper_s_ablation_claims_are_read_as_stated_rules():
     assert ablation_verdict("TPG-NoHierarchy", vs(0.1, 0.79, 0.8)) == "as the paper"
     assert ablation_verdict("TPG-NoHierarchy", vs(0.9, 0.2, 0.5)) == "0.8 or more in CartPole"
     assert ablation_verdict("TPG-NoHierarchy", vs(0.1, 0.2, 0.5)) == "0.8 or more in no task"
+
+
+def test_tpg_robust_has_its_own_section_beside_the_paper_s_experiment(results, tmp_path):
+    folder = tmp_path / "results"
+    shutil.copytree(results / "runs", folder / "runs")
+    settings = tiny_args(
+        "CartPole,MountainCar", root_size=16, n_elite=2, evaluation__test_interval=2
+    )
+    done = mtpg(
+        "train", "--preset", "robust", "--seed", "1", *settings,
+        "--set", "evaluation.test_episodes=5", "--generations", "2",
+        "--out", str(folder / "runs" / "TPG-robust-seed1"),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    text = results_readme.build(folder, analyze=False, probe=True).read_text()
+    section = text[text.index("## TPG-robust") : text.index("## Cost")]
+    assert "**In progress**: 1 of 5 TPG-robust runs begun" in section
+    assert "compared at generation 2" in section
+    seeds = [ln.split(" | ")[0] for ln in section.splitlines() if ln.startswith("| TPG-")]
+    # seed by seed: TPG then TPG-robust of seed 1 (both tables: scores, then the probe)
+    assert seeds[:3] == ["| TPG-seed1", "| TPG-robust-seed1", "| TPG-seed2"]
+    assert "| TPG-robust (1 run) |" in section and "P(TPG-robust > TPG) = " in section
+    assert "| paper (10 runs) | 5 of 10 | 1 of 10 |" in section
+    assert "| TPG-robust-seed1 | 2 | " in section  # the probe of its latest champion
+    # the paper's experiment is of the other runs; TPG-robust is listed with them
+    assert "| TPG-robust-seed1 | TPG-robust | 1 | 2 of 1000 (growing) |" in text
+    assert "IQM over TPG seeds and all tasks" in text
+    assert "TPG (evaluation." not in text  # no group label naming a differing setting
+
+
+def test_robust_section_helpers():
+    import robust_section as rs
+
+    assert rs.seed_of("TPG-robust-seed12") == 12 and rs.is_robust(Path("x/TPG-robust-seed1"))
+    assert not rs.is_robust(Path("TPG-seed1"))
+    with pytest.raises(ValueError, match="seedN"):
+        rs.seed_of("TPG-robust")
+    vs = [{"a": 0.6, "b": 0.95}, {"a": 0.59, "b": 1.0}, {"a": 0.9, "b": 0.9}]
+    assert (rs.reaching(vs, 0.6), rs.reaching(vs, 0.9)) == (2, 1)
+    rows = rs.seed_rows(
+        [("TPG-robust-seed2", 5, {"a": 0.5, "b": 0.1}), ("TPG-seed2", 5, {"a": 1.0, "b": 0.0})],
+        ("a", "b"),
+    )
+    assert rows == [
+        ["TPG-seed2", "5", "1.00", "0.00", "0.00", "0.50"],
+        ["TPG-robust-seed2", "5", "0.50", "0.10", "0.10", "0.30"],
+    ]

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import TextIO
 
 from mtpg.envs.specs.registry import TASKS
-from mtpg.evolve.reporters import Generation, Reporter
+from mtpg.evolve.trainer import Generation, Reporter
 
 #: Short task labels for the status line (the header spells them out): each spec's
 #: ``short``.
@@ -89,7 +89,7 @@ def champion_test(rows: list[dict], subset: str) -> tuple[int, dict[str, float]]
 class Progress(Reporter):
     """Reports each generation of a training run.
 
-    A :class:`~mtpg.evolve.reporters.Reporter`: given to the run with its other reporters,
+    A :class:`~mtpg.evolve.trainer.Reporter`: given to the run with its other reporters,
     it reads each test point's scores from the generation itself. Called as a function
     with a metrics row (the older form), it reads them back from ``tests_file``.
 

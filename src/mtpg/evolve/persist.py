@@ -16,7 +16,7 @@ import numpy as np
 
 from mtpg.config import EXTENSIONS, ConfigError, RunConfig, from_dict, to_dict
 from mtpg.envs.specs.contract import N_OBS
-from mtpg.evolve.trainer import TrainerState
+from mtpg.evolve.state import TrainerState
 from mtpg.io.serialize import FormatError, population_from_dict, population_to_dict
 
 #: Settings a resumed run may change: they do not alter what the run computes.

@@ -1,31 +1,24 @@
-"""The generation loop and its observers ("reporters"), in the spirit of neat-python's.
+"""The reporters that write a run directory: metrics rows, test results, checkpoints.
 
-:func:`generations` yields the trainer's completed generations; :func:`train` hands each
-one to every reporter, in order. Metrics rows, test results, champions and checkpoints
-are reporters, and so is the progress display: the library trains without any run
-directory when given none, e.g. ``train(Trainer(config), [CallbackReporter(print_row)])``.
-
-A generation is a transaction. Reporters see it only once it is complete (varied,
-evaluated, selected and, at a test point, tested), and :meth:`Reporter.end` runs only
-after a complete generation, when the run is done or asked to stop: never from a
-``finally`` with a generation half made. The run directory's commit is the checkpoint
+Each is a :class:`~mtpg.evolve.trainer.Reporter` that :func:`~mtpg.evolve.trainer.train`
+hands every completed generation. The run directory's commit is the checkpoint
 (:class:`CheckpointReporter`): champion files, then the checkpoint file, written
 atomically; rows and test files of later generations are rolled back on resume (see
-:mod:`mtpg.evolve.session`).
+:mod:`mtpg.evolve.session`). The loop itself, :class:`Generation` and :class:`Reporter`
+live in :mod:`mtpg.evolve.trainer` and are importable from here as before.
 """
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from mtpg._faults import point
 from mtpg.config import EvaluationConfig
+from mtpg.evolve.columns import held_out_columns, metric_columns
 from mtpg.evolve.persist import state_to_payload
-from mtpg.evolve.trainer import Trainer, held_out_columns, metric_columns
+from mtpg.evolve.trainer import Generation, Reporter, Trainer, generations, train
 from mtpg.io.checkpoint import checkpoint_path, prune_checkpoints, save_checkpoint
 from mtpg.io.rundir import TESTS_DIR, TESTS_FILE, MetricsWriter, champion_filename, write_champions
 from mtpg.io.serialize import save_graph
@@ -46,34 +39,6 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class Generation:
-    """One completed generation.
-
-    Attributes:
-        number: The generation (1-based).
-        metrics: Its ``metrics.csv`` row (``metric_columns`` keys).
-        tests: Its ``tests.csv`` rows when it was a test point, else None.
-    """
-
-    number: int
-    metrics: dict[str, float]
-    tests: list[dict[str, Any]] | None
-
-
-class Reporter:
-    """Observer of a training run; every method does nothing unless overridden."""
-
-    def start(self, trainer: Trainer) -> None:
-        """Called once before the first generation."""
-
-    def generation(self, gen: Generation, trainer: Trainer) -> None:
-        """Called after each completed generation, in reporter order."""
-
-    def end(self, trainer: Trainer) -> None:
-        """Called when the run is done or stopped at a generation boundary."""
-
-
 class CallbackReporter(Reporter):
     """Calls ``fn(metrics_row, trainer)`` after each generation (e.g. a progress display)."""
 
@@ -83,53 +48,6 @@ class CallbackReporter(Reporter):
     def generation(self, gen: Generation, trainer: Trainer) -> None:
         """Calls the function."""
         self.fn(gen.metrics, trainer)
-
-
-def generations(
-    trainer: Trainer, should_stop: Callable[[], bool] | None = None
-) -> Iterator[Generation]:
-    """Runs generations until the trainer is done or ``should_stop()`` says so.
-
-    ``should_stop`` is asked before each generation, so a stop request is honoured at
-    the next generation boundary. Test points are tested (their time enters ``t_test``
-    and ``t_total``) before the generation is yielded.
-    """
-    while not trainer.done and not (should_stop and should_stop()):
-        row = trainer.run_generation()
-        tests = None
-        if trainer.held_out_due():
-            start = time.perf_counter()
-            tests = trainer.held_out_scores()
-            row["t_test"] = time.perf_counter() - start
-            row["t_total"] += row["t_test"]
-        yield Generation(trainer.state.generation, row, tests)
-
-
-def train(
-    trainer: Trainer,
-    reporters: Sequence[Reporter] = (),
-    should_stop: Callable[[], bool] | None = None,
-) -> bool:
-    """Runs the remaining generations, reporting each.
-
-    Args:
-        trainer: The trainer (fresh or restored).
-        reporters: Observers, called in this order.
-        should_stop: Asked before each generation; True stops the run there.
-
-    Returns:
-        True when every configured generation has run, False when stopped early.
-        An exception raised by a generation or a reporter propagates without
-        :meth:`Reporter.end` being called.
-    """
-    for r in reporters:
-        r.start(trainer)
-    for gen in generations(trainer, should_stop):
-        for r in reporters:
-            r.generation(gen, trainer)
-    for r in reporters:
-        r.end(trainer)
-    return trainer.done
 
 
 class MetricsReporter(Reporter):

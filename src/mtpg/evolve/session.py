@@ -37,12 +37,11 @@ from mtpg.evolve.reporters import (
     CallbackReporter,
     CheckpointReporter,
     MetricsReporter,
-    Reporter,
     TestsReporter,
     champion_graphs,
-    train,
 )
-from mtpg.evolve.trainer import Trainer, TrainerState
+from mtpg.evolve.state import TrainerState
+from mtpg.evolve.trainer import Reporter, Trainer, train
 from mtpg.io.checkpoint import (
     CheckpointError,
     checkpoint_generation,

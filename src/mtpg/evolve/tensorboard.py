@@ -21,8 +21,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from mtpg.evolve.reporters import Generation, Reporter
-from mtpg.evolve.trainer import Trainer
+from mtpg.evolve.trainer import Generation, Reporter, Trainer
 
 #: What to install when the writer is missing (one line for the user).
 MISSING = (

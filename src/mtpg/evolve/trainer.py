@@ -1,124 +1,41 @@
 """The generational loop (paper section 4.1): vary, evaluate new roots, select, delete.
 
-The trainer owns the run state and does no I/O: the loop over generations and the
-reporters that write metrics, tests, checkpoints and champions from what
-:meth:`Trainer.run_generation` returns are in :mod:`mtpg.evolve.reporters`.
+:class:`Trainer` owns the run state and runs one generation at a time, doing no I/O;
+:func:`train` runs the remaining generations and hands each completed one (a
+:class:`Generation`) to every :class:`Reporter`, in order, in the spirit of neat-python's
+reporters. Metrics rows, test results, champions and checkpoints are reporters
+(:mod:`mtpg.evolve.reporters`), and so is the progress display: the library trains without
+any run directory when given none, e.g. ``train(Trainer(config), [CallbackReporter(fn)])``.
+
+A generation is a transaction. Reporters see it only once it is complete (varied,
+evaluated, selected and, at a test point, tested), and :meth:`Reporter.end` runs only
+after a complete generation, when the run is done or asked to stop: never from a
+``finally`` with a generation half made.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from mtpg._faults import point
-from mtpg.config import EvaluationConfig, RunConfig
+from mtpg.config import RunConfig
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.evaluator import Evaluator
 from mtpg.envs.taskset.episode_seeds import resampled_training_seeds, validation_seeds
 from mtpg.evolve.backend import make_evaluator
+from mtpg.evolve.columns import metrics_row
 from mtpg.evolve.heldout_test import play_test
 from mtpg.evolve.lexicase import case_epsilons, lexicase_pick
 from mtpg.evolve.selection import candidates, rankings, select, task_subsets
+from mtpg.evolve.state import TrainerState
 from mtpg.evolve.validation import choose
 from mtpg.evolve.variation import Varier, init_population
-from mtpg.model.graph import Population
-
-#: Metrics columns that measure time and so differ between otherwise identical runs.
-TIMING_COLUMNS = (
-    "decisions_per_s",
-    "t_variation",
-    "t_evaluation",
-    "t_selection",
-    "t_test",
-    "t_total",
-)
-
-
-def held_out_columns(tasks: tuple[str, ...]) -> list[str]:
-    """The ``tests.csv`` header for a run on ``tasks``."""
-    return ["generation", "subset", "root", "graph_teams", "teams_per_decision"] + [
-        f"test_{t}" for t in tasks
-    ]
-
-
-def extra_columns(evaluation: EvaluationConfig | None) -> list[str]:
-    """Columns of the settings beyond the paper that are on (none in ``paper``).
-
-    ``validated_roots`` and ``validation_decisions``: roots first measured on the
-    validation episodes this generation and the decisions that took (validation on);
-    ``reevaluated_roots``: surviving roots evaluated again on redrawn training episodes
-    this generation (resampling on; their decisions are in ``decisions``).
-    """
-    if evaluation is None:
-        return []
-    cols = []
-    if evaluation.validation_episodes > 0:
-        cols += ["validated_roots", "validation_decisions"]
-    if evaluation.resample_interval > 0:
-        cols.append("reevaluated_roots")
-    return cols
-
-
-def metric_columns(tasks: tuple[str, ...], evaluation: EvaluationConfig | None = None) -> list[str]:
-    """The ``metrics.csv`` header for a run on ``tasks`` (with ``evaluation``'s extras)."""
-    cols = [
-        "generation",
-        "roots",
-        "teams",
-        "programs",
-        "banks",
-        "banks_in_use",
-        "programs_per_bank",
-        "new_roots",
-        "decisions",
-        "teams_per_decision",
-        "instructions_per_decision",
-        "champion_teams",
-    ]
-    for task in tasks:
-        cols += [f"best_{task}", f"median_{task}"]
-    return cols + extra_columns(evaluation) + list(TIMING_COLUMNS)
-
-
-@dataclass
-class TrainerState:
-    """Everything a run needs to continue exactly as if never interrupted.
-
-    Attributes:
-        config: The run configuration.
-        generation: Generations completed (0 before initialisation).
-        population: Teams, programs and banks.
-        scores: Mean training score per active task of every evaluated root.
-        elites: Elite root ids of each task subset (``task_subsets`` order).
-        champions: Best root id of each task subset.
-        rng: The generator of every random draw of the run.
-        validation: Mean validation score per active task of every root measured on the
-            validation episodes (only with ``evaluation.validation_episodes > 0``).
-        returns: Training return of every root per task and episode, ``[n_tasks,
-            train_episodes]`` (only with ``team.parent_selection = "lexicase"``).
-        blocks: Training blocks each root has played and the sum of its scores on them,
-            whose quotient is its score (only with ``evaluation.resample_mean``).
-    """
-
-    config: RunConfig
-    generation: int
-    population: Population
-    scores: dict[int, np.ndarray]
-    elites: list[list[int]]
-    champions: list[int]
-    rng: np.random.Generator
-    validation: dict[int, np.ndarray] = field(default_factory=dict)
-    returns: dict[int, np.ndarray] = field(default_factory=dict)
-    blocks: dict[int, tuple[int, np.ndarray]] = field(default_factory=dict)
-
-    @classmethod
-    def new(cls, config: RunConfig) -> TrainerState:
-        """The state of a run that has not started."""
-        rng = np.random.default_rng(np.random.SeedSequence(config.seed))
-        return cls(config, 0, Population(), {}, [], [], rng)
 
 
 class Trainer:
@@ -224,7 +141,17 @@ class Trainer:
         self._select()
         t3 = time.perf_counter()
         st.generation = gen
-        return self._metrics(new_roots, result, (t0, t1, t2, t3))
+        return metrics_row(
+            gen,
+            st.population,
+            st.scores,
+            st.champions[-1],
+            self.tasks.names,
+            new_roots,
+            result,
+            self._extra,
+            (t0, t1, t2, t3),
+        )
 
     def held_out_due(self) -> bool:
         """True when the generation just completed is a test point.
@@ -366,36 +293,77 @@ class Trainer:
         st.champions = choose(cands, st.validation, self.subsets, self.task_ids, self.tasks)
         self._extra.update(validated_roots=len(todo), validation_decisions=decisions)
 
-    def _metrics(self, new_roots, result, times) -> dict[str, float]:
-        st, pop = self.state, self.state.population
-        decisions = int(result.steps.sum())
-        in_use = pop.banks_in_use()
-        scores = np.array([st.scores[r] for r in sorted(st.scores)])
-        row: dict[str, float] = {
-            "generation": st.generation,
-            "roots": len(st.scores),
-            "teams": len(pop.teams),
-            "programs": len(pop.programs),
-            "banks": len(pop.memory_banks),
-            "banks_in_use": len(in_use),
-            "programs_per_bank": len(pop.programs) / max(len(in_use), 1),
-            "new_roots": len(new_roots),
-            "decisions": decisions,
-            "teams_per_decision": result.teams.sum() / max(decisions, 1),
-            "instructions_per_decision": result.instructions.sum() / max(decisions, 1),
-            "champion_teams": len(pop.reachable(st.champions[-1])),
-        }
-        for k, name in enumerate(self.tasks.names):
-            row[f"best_{name}"] = float(scores[:, k].max())
-            row[f"median_{name}"] = float(np.median(scores[:, k]))
-        row.update(self._extra)
-        t0, t1, t2, t3 = times
-        row.update(
-            decisions_per_s=decisions / max(t2 - t1, 1e-9),
-            t_variation=t1 - t0,
-            t_evaluation=t2 - t1,
-            t_selection=t3 - t2,
-            t_test=0.0,
-            t_total=t3 - t0,
-        )
-        return row
+
+@dataclass(frozen=True)
+class Generation:
+    """One completed generation.
+
+    Attributes:
+        number: The generation (1-based).
+        metrics: Its ``metrics.csv`` row (``metric_columns`` keys).
+        tests: Its ``tests.csv`` rows when it was a test point, else None.
+    """
+
+    number: int
+    metrics: dict[str, float]
+    tests: list[dict[str, Any]] | None
+
+
+class Reporter:
+    """Observer of a training run; every method does nothing unless overridden."""
+
+    def start(self, trainer: Trainer) -> None:
+        """Called once before the first generation."""
+
+    def generation(self, gen: Generation, trainer: Trainer) -> None:
+        """Called after each completed generation, in reporter order."""
+
+    def end(self, trainer: Trainer) -> None:
+        """Called when the run is done or stopped at a generation boundary."""
+
+
+def generations(
+    trainer: Trainer, should_stop: Callable[[], bool] | None = None
+) -> Iterator[Generation]:
+    """Runs generations until the trainer is done or ``should_stop()`` says so.
+
+    ``should_stop`` is asked before each generation, so a stop request is honoured at
+    the next generation boundary. Test points are tested (their time enters ``t_test``
+    and ``t_total``) before the generation is yielded.
+    """
+    while not trainer.done and not (should_stop and should_stop()):
+        row = trainer.run_generation()
+        tests = None
+        if trainer.held_out_due():
+            start = time.perf_counter()
+            tests = trainer.held_out_scores()
+            row["t_test"] = time.perf_counter() - start
+            row["t_total"] += row["t_test"]
+        yield Generation(trainer.state.generation, row, tests)
+
+
+def train(
+    trainer: Trainer,
+    reporters: Sequence[Reporter] = (),
+    should_stop: Callable[[], bool] | None = None,
+) -> bool:
+    """Runs the remaining generations, reporting each.
+
+    Args:
+        trainer: The trainer (fresh or restored).
+        reporters: Observers, called in this order.
+        should_stop: Asked before each generation; True stops the run there.
+
+    Returns:
+        True when every configured generation has run, False when stopped early.
+        An exception raised by a generation or a reporter propagates without
+        :meth:`Reporter.end` being called.
+    """
+    for r in reporters:
+        r.start(trainer)
+    for gen in generations(trainer, should_stop):
+        for r in reporters:
+            r.generation(gen, trainer)
+    for r in reporters:
+        r.end(trainer)
+    return trainer.done

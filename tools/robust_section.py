@@ -4,11 +4,12 @@ TPG-robust is the ``robust`` preset (the ``paper`` preset with the training epis
 redrawn every 10 generations; ``tools/grow_results.py --plan robust``), seeds 1 to 5,
 beside the TPG runs in ``results/runs``. :func:`section` writes its part of the page from
 the runs' files: both groups compared at one common test point (generation 1,000 once
-every run has reached it; while TPG-robust grows, its runs' earliest latest test point,
-so that the two groups are compared at the same age), seed by seed and over seeds
-(interquartile means with 95% bootstrap intervals and the probability of improvement),
-the count of runs whose all-task champion reaches 0.6 and 0.9 of the best single-task
-champion in all tasks, the memorisation probe of every final champion and the cost.
+every run has reached it; while TPG-robust grows, the latest test point all its runs
+have reached, so that the two groups are compared at the same age), seed by seed and
+over seeds (interquartile means with 95% bootstrap intervals and the probability of
+improvement), the count of runs whose all-task champion reaches 0.6 and 0.9 of the best
+single-task champion in all tasks, the memorisation probe of every final champion and
+the cost.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ def seed_of(name: str) -> int:
 
 
 def common_generation(robust, target: int) -> int:
-    """The test point both groups are compared at: the robust runs' earliest latest one."""
+    """The test point both groups are compared at: the latest all robust runs have reached."""
     return min(target, *(r.final_generation for r in robust))
 
 
@@ -162,8 +163,8 @@ def section(tpg, robust, best_single: dict[str, float], probes: dict, target: in
         lines += [
             f"**In progress**: {len(robust)} of 5 TPG-robust runs begun"
             + (f", {', '.join(growing)} still growing" if growing else "")
-            + f". Both groups are compared at generation {gen:,}, the earliest latest test "
-            "point of the TPG-robust runs, from `tests.csv`: the TPG runs' champions of "
+            + f". Both groups are compared at generation {gen:,}, the latest test point "
+            "every TPG-robust run has reached, from `tests.csv`: the TPG runs' champions of "
             "that generation, not their final ones.",
             "",
         ]

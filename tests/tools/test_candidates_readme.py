@@ -1,18 +1,10 @@
 """``tools/candidates_readme.py``: the candidates' table from per-run normalised scores."""
 
-import importlib.util
-import sys
-from pathlib import Path
-
-TOOL = Path(__file__).parents[2] / "tools" / "candidates_readme.py"
+from toolmodules import load_tool
 
 
 def _tool():
-    spec = importlib.util.spec_from_file_location("candidates_readme", TOOL)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["candidates_readme"] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("candidates_readme")
 
 
 def test_table_lists_every_run_and_compares_the_groups():

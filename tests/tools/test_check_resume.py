@@ -1,22 +1,14 @@
 """``tools/check_resume.py``: a committed run resumed from an earlier commit is compared."""
 
 import csv
-import importlib.util
 import subprocess
-import sys
-from pathlib import Path
 
 from stopruns import SETTINGS
-
-TOOLS = Path(__file__).parents[2] / "tools"
+from toolmodules import load_tool
 
 
 def _tool(name):
-    spec = importlib.util.spec_from_file_location(name, TOOLS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return load_tool(name)
 
 
 def _git(repo, *args):

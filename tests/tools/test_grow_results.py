@@ -1,24 +1,17 @@
 """``tools/grow_results.py``: runs grown in slices equal uninterrupted runs, and are committed."""
 
 import csv
-import importlib.util
 import subprocess
-import sys
 import tarfile
-from pathlib import Path
 
 from stopruns import SETTINGS, mtpg, without_timing
+from toolmodules import load_tool
 
-TOOL = Path(__file__).parents[2] / "tools" / "grow_results.py"
 GENERATIONS = 24
 
 
 def _tool():
-    spec = importlib.util.spec_from_file_location("grow_results", TOOL)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["grow_results"] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("grow_results")
 
 
 def _git(repo, *args):

@@ -6,20 +6,15 @@ rather than on the next mutation run.
 """
 
 import glob
-import importlib.util
-import sys
 from pathlib import Path
 
+from toolmodules import load_tool
+
 ROOT = Path(__file__).parents[2]
-TOOL = ROOT / "tools" / "mutation.py"
 
 
 def _tool():
-    spec = importlib.util.spec_from_file_location("mutation", TOOL)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["mutation"] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("mutation")
 
 
 def test_every_hand_mutant_finds_its_line_exactly_once():

@@ -14,33 +14,28 @@ sys.path.insert(0, str(Path(__file__).parents[2] / "tools"))
 import results_readme
 
 
-@pytest.fixture(scope="module")
-def results(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("results")
+def _tiny_run(out, preset, seed, generations, *flags):
+    """Trains a tiny run of ``preset`` (two tasks, test point every 2) into ``out``."""
     settings = tiny_args(
         "CartPole,MountainCar", root_size=16, n_elite=2, evaluation__test_interval=2
     )
-    for name, seed, flag in (
+    done = mtpg(
+        "train", "--preset", preset, "--seed", str(seed), *flags, *settings,
+        "--set", "evaluation.test_episodes=5", "--generations", str(generations),
+        "--out", str(out),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("results")
+    for name, seed, flags in (
         ("TPG-seed1", 1, []),
         ("TPG-seed2", 2, []),
         ("TPG-NoMemory-seed1", 1, ["--no-memory"]),
     ):
-        done = mtpg(
-            "train",
-            "--preset",
-            "paper",
-            "--seed",
-            str(seed),
-            *flag,
-            *settings,
-            "--set",
-            "evaluation.test_episodes=5",
-            "--generations",
-            "4",
-            "--out",
-            str(folder / "runs" / name),
-        )
-        assert done.returncode == 0, done.stderr
+        _tiny_run(folder / "runs" / name, "paper", seed, 4, *flags)
     return folder
 
 
@@ -92,15 +87,7 @@ def test_summaries_leave_out_runs_still_growing_once_some_are_finished(
 
     folder = tmp_path / "results"
     shutil.copytree(results / "runs", folder / "runs")
-    settings = tiny_args(
-        "CartPole,MountainCar", root_size=16, n_elite=2, evaluation__test_interval=2
-    )
-    done = mtpg(
-        "train", "--preset", "paper", "--seed", "3", *settings,
-        "--set", "evaluation.test_episodes=5", "--generations", "4",
-        "--out", str(folder / "runs" / "TPG-seed3"),
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr
+    _tiny_run(folder / "runs" / "TPG-seed3", "paper", 3, 4)
     tests = folder / "runs" / "TPG-seed3" / "tests.csv"  # as if still growing: test point 2
     head, *rows = tests.read_text().splitlines()
     column = head.split(",").index("generation")
@@ -154,15 +141,7 @@ def test_the_paper_s_ablation_claims_are_read_as_stated_rules():
 def test_tpg_robust_has_its_own_section_beside_the_paper_s_experiment(results, tmp_path):
     folder = tmp_path / "results"
     shutil.copytree(results / "runs", folder / "runs")
-    settings = tiny_args(
-        "CartPole,MountainCar", root_size=16, n_elite=2, evaluation__test_interval=2
-    )
-    done = mtpg(
-        "train", "--preset", "robust", "--seed", "1", *settings,
-        "--set", "evaluation.test_episodes=5", "--generations", "2",
-        "--out", str(folder / "runs" / "TPG-robust-seed1"),
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr
+    _tiny_run(folder / "runs" / "TPG-robust-seed1", "robust", 1, 2)
     text = results_readme.build(folder, analyze=False, probe=True).read_text()
     section = text[text.index("## TPG-robust") : text.index("## Cost")]
     assert "**In progress**: 1 of 5 TPG-robust runs begun" in section

@@ -3,9 +3,10 @@
 TPG-robust is the ``robust`` preset (the ``paper`` preset with the training episodes
 redrawn every 10 generations; ``tools/grow_results.py --plan robust``), seeds 1 to 5,
 beside the TPG runs in ``results/runs``. :func:`section` writes its part of the page from
-the runs' files: both groups compared at one common test point (generation 1,000 once
-every run has reached it; while TPG-robust grows, the latest test point all its runs
-have reached, so that the two groups are compared at the same age), seed by seed and
+the runs' files: both groups compared at one common test point (generation 1,000, with
+the TPG-robust runs that have reached it; before any has, the latest test point all
+TPG-robust runs have reached, so that the two groups are compared at the same age), seed
+by seed and
 over seeds (interquartile means with 95% bootstrap intervals and the probability of
 improvement), the count of runs whose all-task champion reaches 0.6 and 0.9 of the best
 single-task champion in all tasks, the memorisation probe of every final champion and
@@ -42,6 +43,19 @@ def seed_of(name: str) -> int:
 def common_generation(robust, target: int) -> int:
     """The test point both groups are compared at: the latest all robust runs have reached."""
     return min(target, *(r.final_generation for r in robust))
+
+
+def compared_runs(robust, target: int) -> tuple[list, int]:
+    """The TPG-robust runs in the comparison and its generation.
+
+    The runs that have reached ``target`` are compared there; a run still growing would
+    pull the comparison back to its own age, so it waits until it arrives. Before any run
+    has arrived, every run is compared at the latest test point all have reached.
+    """
+    done = [r for r in robust if r.final_generation >= target]
+    if done:
+        return done, target
+    return list(robust), common_generation(robust, target)
 
 
 def scores_at(run, generation: int) -> dict[str, float]:
@@ -137,8 +151,8 @@ def section(tpg, robust, best_single: dict[str, float], probes: dict, target: in
     from mtpg.analysis.runs.statistics_figures import POI_NOTE, STATS_NOTE
 
     tasks = tpg[0].tasks
-    gen = common_generation(robust, target)
-    groups = {"TPG": tpg, "TPG-robust": robust}
+    compared, gen = compared_runs(robust, target)
+    groups = {"TPG": tpg, "TPG-robust": compared}
     norm = {r.name: normalised_at(r, gen) for g in groups.values() for r in g}
     vs = {r.name: normalised_at(r, gen, best_single) for g in groups.values() for r in g}
     matrices = {
@@ -160,12 +174,23 @@ def section(tpg, robust, best_single: dict[str, float], probes: dict, target: in
     growing = [r.name for r in robust if r.final_generation < target]
     missing = 5 - len(robust)
     if growing or missing > 0:
+        if gen == target:
+            where = (
+                f"Both groups are compared at generation {gen:,} with the "
+                f"{_runs(len(compared))} of TPG-robust that have reached it; the runs still "
+                "growing are not in the comparison (their latest champions are in the probe "
+                "table below)."
+            )
+        else:
+            where = (
+                f"Both groups are compared at generation {gen:,}, the latest test point "
+                "every TPG-robust run has reached, from `tests.csv`: the TPG runs' champions "
+                "of that generation, not their final ones."
+            )
         lines += [
             f"**In progress**: {len(robust)} of 5 TPG-robust runs begun"
             + (f", {', '.join(growing)} still growing" if growing else "")
-            + f". Both groups are compared at generation {gen:,}, the latest test point "
-            "every TPG-robust run has reached, from `tests.csv`: the TPG runs' champions of "
-            "that generation, not their final ones.",
+            + f". {where}",
             "",
         ]
     lines += [

@@ -175,3 +175,19 @@ def test_robust_section_helpers():
         ["TPG-seed2", "5", "1.00", "0.00", "0.00", "0.50"],
         ["TPG-robust-seed2", "5", "0.50", "0.10", "0.10", "0.30"],
     ]
+
+
+def test_robust_runs_that_reached_the_target_are_compared_there():
+    from types import SimpleNamespace as Run
+
+    import robust_section as rs
+
+    done, mid, young = (
+        Run(final_generation=1000),
+        Run(final_generation=640),
+        Run(final_generation=90),
+    )
+    # the finished runs at the target; the growing ones wait (they would pull it back)
+    assert rs.compared_runs([done, young, done], 1000) == ([done, done], 1000)
+    # none there yet: every run, at the latest test point all have reached
+    assert rs.compared_runs([mid, young], 1000) == ([mid, young], 90)

@@ -6,8 +6,7 @@ beside the TPG runs in ``results/runs``. :func:`section` writes its part of the 
 the runs' files: both groups compared at one common test point (generation 1,000, with
 the TPG-robust runs that have reached it; before any has, the latest test point all
 TPG-robust runs have reached, so that the two groups are compared at the same age), seed
-by seed and
-over seeds (interquartile means with 95% bootstrap intervals and the probability of
+by seed and over seeds (interquartile means with 95% bootstrap intervals and the probability of
 improvement), the count of runs whose all-task champion reaches 0.6 and 0.9 of the best
 single-task champion in all tasks, the memorisation probe of every final champion and
 the cost.

@@ -10,7 +10,10 @@ continues the unfinished runs of :data:`PLAN` (or, with ``--plan robust``, of
 :data:`ROBUST_PLAN` beside them; with ``--plan demo``, of
 :data:`DEMO_PLAN` in ``results/candidates``, ``--plan variants`` of :data:`VARIANTS_PLAN` in
 ``results/variants``) in order, ``--parallel`` at a time, each an
-ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun). Every
+ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun) on
+``--workers`` threads. The last run left takes the threads of the runs that finished
+(``--parallel`` times ``--workers``): it commits the generation under way and resumes on
+all of them, the same run, since results do not depend on the thread count. Every
 ``--slice`` minutes, and when the budget is spent or the script is stopped (SIGTERM,
 SIGINT, SIGHUP), the runs are sent SIGTERM, so each commits the generation under way and
 ends; then every run touched is tidied for the repository and committed with git:
@@ -187,9 +190,12 @@ class Job:
     path: Path
     proc: subprocess.Popen
     start_gen: int
+    workers: int = 1
     started: float = field(default_factory=time.time)
     status: int | None = None
     cpu_s: float = 0.0
+    end_gen: int = 0
+    ended: float = 0.0
 
     def poll(self) -> bool:
         """True once the process has ended (its status and CPU time then recorded)."""
@@ -199,13 +205,18 @@ class Job:
                 self.status = os.waitstatus_to_exitcode(status)
                 self.proc.returncode = self.status
                 self.cpu_s = usage.ru_utime + usage.ru_stime
+                self.end_gen = last_generation(self.path)
+                self.ended = time.time()
         return self.status is not None
 
 
-def start(name: str, seed: int, ablation: str | None, args: argparse.Namespace) -> Job:
-    """Starts (or resumes) one run of the plan."""
+def start(
+    name: str, seed: int, ablation: str | None, args: argparse.Namespace, workers: int = 0
+) -> Job:
+    """Starts (or resumes) one run of the plan, on ``workers`` threads (``--workers``)."""
     path = args.results / "runs" / name
-    common = ["--generations", str(args.generations), "--workers", str(args.workers), "--quiet"]
+    workers = workers or args.workers
+    common = ["--generations", str(args.generations), "--workers", str(workers), "--quiet"]
     if (path / "config.toml").is_file():
         cmd = ["train", "--resume", str(path), *common]
     else:
@@ -220,7 +231,12 @@ def start(name: str, seed: int, ablation: str | None, args: argparse.Namespace) 
         stderr=subprocess.STDOUT,
         start_new_session=True,
     )
-    return Job(name, path, proc, last_generation(path))
+    return Job(name, path, proc, last_generation(path), workers)
+
+
+def began(job: Job) -> bool:
+    """True once the job's run can be resumed (its ``config.toml`` is written)."""
+    return (job.path / "config.toml").is_file()
 
 
 def _pack(folder: Path, names: list[str], archive: Path) -> None:
@@ -269,9 +285,9 @@ def tidy(run: Path) -> None:
         shutil.rmtree(f)
 
 
-def record(job: Job, commit: str, workers: int) -> None:
-    """Appends the job's row to its run's ``provenance.csv``."""
-    end = last_generation(job.path)
+def record(job: Job, commit: str) -> None:
+    """Appends the ended job's row to its run's ``provenance.csv``."""
+    end = job.end_gen
     if end == job.start_gen:
         return
     path = job.path / PROVENANCE
@@ -281,7 +297,7 @@ def record(job: Job, commit: str, workers: int) -> None:
         if new:
             w.writerow(PROVENANCE_COLUMNS)
         started = datetime.fromtimestamp(job.started, UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
-        wall = time.time() - job.started
+        wall = job.ended - job.started
         host = platform.node()
         w.writerow(
             [
@@ -291,7 +307,7 @@ def record(job: Job, commit: str, workers: int) -> None:
                 started,
                 f"{wall:.0f}",
                 f"{job.cpu_s:.0f}",
-                workers,
+                job.workers,
                 processor(),
                 host,
             ]
@@ -375,6 +391,8 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(sig, lambda s, _f: stop.append(s))
     end = time.time() + 60 * args.budget
     failed: set[str] = set()
+    by_name = {r[0]: r for r in plan}
+    all_threads = args.parallel * args.workers
 
     def unfinished() -> list[tuple[str, int, str | None]]:
         runs = args.results / "runs"
@@ -394,18 +412,29 @@ def main(argv: list[str] | None = None) -> int:
         )
         while (todo or running) and not stop and time.time() < slice_end:
             while todo and len(running) < args.parallel:
-                job = start(*todo.pop(0), args)
+                alone = len(todo) == 1 and not running
+                job = start(*todo.pop(0), args, all_threads if alone else args.workers)
                 print(f"{job.name}: generation {job.start_gen} -> {args.generations}", flush=True)
                 jobs.append(job)
                 running.append(job)
             for job in [j for j in running if j.poll()]:
                 running.remove(job)
                 print(f"{job.name}: ended ({job.status}) at {last_generation(job.path)}")
+                last = running[0] if len(running) == 1 and not todo else None
+                if last and last.workers < all_threads and not last.poll() and began(last):
+                    # the last run takes the threads of those that finished: it commits
+                    # the generation under way and resumes on all of them (same run)
+                    alone = running.pop()
+                    stop_all([alone])
+                    job = start(*by_name[alone.name], args, all_threads)
+                    print(f"{job.name}: on {all_threads} threads from {job.start_gen}", flush=True)
+                    jobs.append(job)
+                    running.append(job)
             time.sleep(1)
         stop_all(running)
         for job in jobs:
             tidy(job.path)
-            record(job, commit, args.workers)
+            record(job, commit)
             if last_generation(job.path) < args.generations and job.status not in (0, 143):
                 print(f"{job.name}: failed ({job.status}); see {job.path}.log", flush=True)
                 failed.add(job.name)

@@ -4,10 +4,14 @@ import csv
 import subprocess
 import tarfile
 
+from mtpg.io.checkpoint import load_checkpoint
 from stopruns import SETTINGS, mtpg, without_timing
+from tinyruns import tiny_args
 from toolmodules import load_tool
 
 GENERATIONS = 24
+#: A run some ten times slower than ``SETTINGS``'s.
+SLOW = tiny_args("CartPole,MountainCar", root_size=200, n_elite=40, evaluation__train_episodes=100)
 
 
 def _tool():
@@ -107,3 +111,47 @@ def test_the_demo_plan_starts_demo_runs_with_and_without_resampling(tmp_path, mo
     resampled = [c for c in started if "evaluation.resample_interval=10" in c]
     assert len(resampled) == 5
     assert all("resample10" in c[c.index("--out") + 1] for c in resampled)
+
+
+def test_the_last_run_left_takes_the_threads_of_the_runs_that_finished(
+    tmp_path, monkeypatch, capsys
+):
+    for key in ("AUTHOR", "COMMITTER"):
+        monkeypatch.setenv(f"GIT_{key}_NAME", "mtpg tests")
+        monkeypatch.setenv(f"GIT_{key}_EMAIL", "tests@mtpg.invalid")
+    repo = tmp_path / "repo"
+    (repo / "results").mkdir(parents=True)
+    _git(repo, "init", "-q")
+    _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
+    tool = _tool()
+    near, far = ("TPG-seed3", 3, None), ("TPG-seed4", 4, None)
+    argv = ["--budget", "5", "--unchecked", "--results", str(repo / "results")]
+    monkeypatch.setattr(tool, "PLAN", (near,))
+    near_args = [f"--train-arg={a}" for a in SETTINGS]
+    assert tool.main([*argv, *near_args, "--generations", "16"]) == 0
+    monkeypatch.setattr(tool, "PLAN", (near, far))
+    capsys.readouterr()
+    # the run begun now is slower, so that it is still running when the other ends
+    far_args = [f"--train-arg={a}" for a in SLOW]
+    assert tool.main([*argv, *far_args, "--generations", str(GENERATIONS)]) == 0
+    assert "TPG-seed4: on 2 threads from " in capsys.readouterr().out
+
+    grown = repo / "results" / "runs" / "TPG-seed4"
+    rows = list(csv.DictReader(open(grown / "provenance.csv")))
+    # one thread until the other run ended (no row if it had not finished a generation)
+    assert [r["workers"] for r in rows] in (["1", "2"], ["2"])
+    assert rows[0]["from_generation"] == "0" and rows[-1]["to_generation"] == str(GENERATIONS)
+    for a, b in zip(rows, rows[1:], strict=False):
+        assert a["to_generation"] == b["from_generation"]
+    ref = tmp_path / "ref"
+    args = ["train", "--preset", "paper", "--seed", "4", *SLOW]
+    assert mtpg(*args, "--generations", str(GENERATIONS), "--out", str(ref)).returncode == 0
+    for table in ("metrics.csv", "tests.csv"):
+        assert without_timing((grown / table).read_text()) == without_timing(
+            (ref / table).read_text()
+        )
+    # the same state; the configuration it stores names the threads it ran on
+    final = f"gen-{GENERATIONS:06d}.json.gz"
+    states = [load_checkpoint(d / "checkpoints" / final) for d in (grown, ref)]
+    assert [s["config"].pop("workers") for s in states] == [2, 1]
+    assert states[0] == states[1]

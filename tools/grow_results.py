@@ -316,7 +316,7 @@ def record(job: Job, commit: str) -> None:
 
 def commit_results(repo: Path, results: Path, jobs: list[Job]) -> None:
     """Commits ``results/runs`` (and nothing else that may be staged)."""
-    moved = [f"{j.name} {j.start_gen}->{last_generation(j.path)}" for j in jobs]
+    moved = [f"{j.name} {j.start_gen}->{j.end_gen}" for j in jobs]
     runs = str((results / "runs").relative_to(repo))
     # run logs and lock files stay out, whatever the repository's ignore rules
     sh("git", "add", "-A", "--", runs, f":!{runs}/*.log", f":!{runs}/*/.lock", cwd=repo)

@@ -143,6 +143,9 @@ def test_the_last_run_left_takes_the_threads_of_the_runs_that_finished(
     assert rows[0]["from_generation"] == "0" and rows[-1]["to_generation"] == str(GENERATIONS)
     for a, b in zip(rows, rows[1:], strict=False):
         assert a["to_generation"] == b["from_generation"]
+    message = _git(repo, "log", "-1", "--format=%s").stdout
+    for r in rows:  # each process's own generations
+        assert f"TPG-seed4 {r['from_generation']}->{r['to_generation']}" in message
     ref = tmp_path / "ref"
     args = ["train", "--preset", "paper", "--seed", "4", *SLOW]
     assert mtpg(*args, "--generations", str(GENERATIONS), "--out", str(ref)).returncode == 0

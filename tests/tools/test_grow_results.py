@@ -22,7 +22,8 @@ def _git(repo, *args):
     return subprocess.run(["git", *args], cwd=repo, capture_output=True, text=True, check=True)
 
 
-def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypatch):
+def _repo(tmp_path, monkeypatch):
+    """A git repository with a ``results/`` folder, committing as the tests."""
     for key in ("AUTHOR", "COMMITTER"):
         monkeypatch.setenv(f"GIT_{key}_NAME", "mtpg tests")
         monkeypatch.setenv(f"GIT_{key}_EMAIL", "tests@mtpg.invalid")
@@ -30,6 +31,11 @@ def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypa
     (repo / "results").mkdir(parents=True)
     _git(repo, "init", "-q")
     _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
+    return repo
+
+
+def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypatch):
+    repo = _repo(tmp_path, monkeypatch)
     tool = _tool()
     monkeypatch.setattr(
         tool, "PLAN", (("TPG-seed3", 3, None), ("TPG-NoMemory-seed3", 3, "no-memory"))
@@ -116,13 +122,7 @@ def test_the_demo_plan_starts_demo_runs_with_and_without_resampling(tmp_path, mo
 def test_the_last_run_left_takes_the_threads_of_the_runs_that_finished(
     tmp_path, monkeypatch, capsys
 ):
-    for key in ("AUTHOR", "COMMITTER"):
-        monkeypatch.setenv(f"GIT_{key}_NAME", "mtpg tests")
-        monkeypatch.setenv(f"GIT_{key}_EMAIL", "tests@mtpg.invalid")
-    repo = tmp_path / "repo"
-    (repo / "results").mkdir(parents=True)
-    _git(repo, "init", "-q")
-    _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
+    repo = _repo(tmp_path, monkeypatch)
     tool = _tool()
     near, far = ("TPG-seed3", 3, None), ("TPG-seed4", 4, None)
     argv = ["--budget", "5", "--unchecked", "--results", str(repo / "results")]

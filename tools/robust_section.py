@@ -245,8 +245,9 @@ def section(tpg, robust, best_single: dict[str, float], probes: dict, target: in
     }
     lines += [
         f"Cost: seconds per generation over generations 1 to {gen:,} (`metrics.csv`'s "
-        "`t_total`, test points included; one thread, two runs at a time on a 2-core "
-        "machine shared with other work): "
+        "`t_total`, test points included; one thread per run, two runs at a time on a "
+        "2-core machine shared with other work, except where a run's `provenance.csv` "
+        "names more threads): "
         + ", ".join(f"{label} {sec:.1f} s" for label, sec in cost.items())
         + ". Per run, hours in all: Cost below.",
         "",

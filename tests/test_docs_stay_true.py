@@ -208,6 +208,14 @@ def test_the_readme_quotes_the_committed_results_as_results_readme_has_them():
     assert f"IQM over TPG seeds and all tasks: {iqm}." in results
 
 
+def test_the_readme_answers_does_it_reproduce_the_paper_as_the_results_page_does():
+    """The README's answer is the page's, word for word (``tools/robust_section.answer``)."""
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    results = (ROOT / "results" / "README.md").read_text(encoding="utf-8")
+    [answer] = [ln for ln in results.splitlines() if ln.startswith("**Does it reproduce")]
+    assert f"- {answer} " in readme
+
+
 def test_the_architecture_page_names_the_runs_mtpg_experiment_plans():
     from mtpg.evolve.experiment import plan
 

@@ -39,7 +39,7 @@ from results_text import (  # the tool's own helper modules beside it
     resume_check_rows,
     status_rows,
 )
-from robust_section import is_robust
+from robust_section import answer, compare, is_robust
 from robust_section import section as robust_section
 
 TARGET = 1000
@@ -153,9 +153,11 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
             else ""
         ),
         "",
-        "## Status",
-        "",
     ]
+    comparison = compare(tpg.runs, robust, best_single, TARGET) if robust else None
+    if comparison is not None and comparison.complete:
+        lines += [*answer(comparison), ""]
+    lines += ["## Status", ""]
     done = len(at_target) == len(runs)
     if done and any(r.final_generation < TARGET for r in robust):
         lines += [
@@ -292,15 +294,16 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
             from mtpg.analysis.runs.memorisation import probe_target
 
             probes = {r.name: probe_target(r.path) for r in [*tpg.runs, *robust]}
-        lines += robust_section(tpg.runs, robust, best_single, probes, TARGET)
+        lines += robust_section(comparison, robust, probes, TARGET)
     lines += ["## Cost", ""]
     lines += [
         "Wall-clock hours: the sum of `metrics.csv`'s `t_total` (every generation, test "
         "points included). CPU hours: from `provenance.csv` (the process's user and system "
         "time per sitting; sittings recorded without it are left out and the generations "
-        "covered are named). Each run ran with `--workers 1`, two runs at a time on a "
-        "2-core machine, while other work shared it, so these are upper bounds of what a "
-        "quiet machine needs (the processor is in each run's `provenance.csv`).",
+        "covered are named). Each run ran with `--workers 1` (one thread; `provenance.csv` "
+        "names the sittings that ran on more), two runs at a time on a 2-core machine, "
+        "while other work shared it, so these are upper bounds of what a quiet machine "
+        "needs (the processor is in each run's `provenance.csv`).",
         "",
     ]
     lines += markdown_table(*cost_rows(every)) + [""]

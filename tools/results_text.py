@@ -8,6 +8,7 @@ is typed in by hand but :data:`PAPER`, the paper's own figures (section 5).
 from __future__ import annotations
 
 import csv
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,9 @@ PAPER = {
     "TPG-NoMemory": "well below 0.5 in every task",
     "TPG-NoHierarchy": "good only in MountainCarContinuous",
 }
+#: The repository (for git) and the commit that made the lane engine training's default.
+ROOT = Path(__file__).resolve().parents[1]
+LANE_ENGINE = "34fc1cf53f85672be4d76cb35f245edc1ad9ef62"
 #: Within this of the paper's figure counts as level.
 LEVEL = 0.05
 #: Generations at which the cost is quoted.
@@ -285,3 +289,51 @@ def resume_check_rows(path: Path) -> tuple[list[str], list[list[str]]]:
         for r in csv.DictReader(path.open())
     ]
     return head, rows
+
+
+def cpu_seconds_per_generation(paths: list[Path]) -> float:
+    """CPU seconds per generation over the sittings of ``provenance.csv`` that recorded it."""
+    rows = [p for path in paths for p in provenance(path) if p["cpu_s"]]
+    gens = sum(int(p["to_generation"]) - int(p["from_generation"]) for p in rows)
+    return sum(float(p["cpu_s"]) for p in rows) / gens if gens else float("nan")
+
+
+def on_lane_engine(commit: str, repo: Path = ROOT) -> bool | None:
+    """Whether an mtpg commit has the lane engine; None where git cannot tell."""
+    try:
+        done = subprocess.run(
+            ["git", "-C", str(repo), "merge-base", "--is-ancestor", LANE_ENGINE, commit],
+            capture_output=True,
+            check=False,
+        )
+    except OSError:
+        return None
+    return {0: True, 1: False}.get(done.returncode)
+
+
+def engine_note(groups: dict[str, list[Path]], repo: Path = ROOT) -> str:
+    """A sentence when the groups grew on different engines (empty when git cannot tell).
+
+    The lane engine takes less CPU time than the engines before it, so a group grown with
+    it and one grown without are not compared like for like.
+    """
+    kinds = {}
+    for label, paths in groups.items():
+        commits = {p["mtpg_commit"] for path in paths for p in provenance(path)}
+        found = {on_lane_engine(c, repo) for c in commits}
+        if None in found or not found:
+            return ""
+        kinds[label] = "with" if found == {True} else "before" if found == {False} else "mixed"
+    if len(set(kinds.values())) == 1:
+        return ""
+    said = {
+        "with": "with the lane engine",
+        "before": "with engines before the lane engine",
+        "mixed": "partly with the lane engine",
+    }
+    return (
+        "Not like for like: "
+        + "; ".join(f"{label} grew {said[k]}" for label, k in kinds.items())
+        + f" ({LANE_ENGINE[:7]}, [docs/engine.md](../docs/engine.md#the-lane-engine)), "
+        "which takes less CPU time per generation."
+    )

@@ -155,6 +155,7 @@ def test_tpg_robust_has_its_own_section_beside_the_paper_s_experiment(results, t
     # the paper's experiment is of the other runs; TPG-robust is listed with them
     assert "| TPG-robust-seed1 | TPG-robust | 1 | 2 of 1000 (growing) |" in text
     assert "IQM over TPG seeds and all tasks" in text
+    assert "**Does it reproduce" not in text  # answered once all five runs are there
     assert "TPG (evaluation." not in text  # no group label naming a differing setting
 
 
@@ -191,3 +192,91 @@ def test_robust_runs_that_reached_the_target_are_compared_there():
     assert rs.compared_runs([done, young, done], 1000) == ([done, done], 1000)
     # none there yet: every run, at the latest test point all have reached
     assert rs.compared_runs([mid, young], 1000) == ([mid, young], 90)
+
+
+def _comparison(tpg_scores, robust_scores, vs_scale=1.0):
+    """A comparison of hand-made scores (``vs``: the scores times ``vs_scale``)."""
+    from types import SimpleNamespace as Run
+
+    import numpy as np
+    import robust_section as rs
+
+    tasks = ["A", "B", "C"]
+    groups = {
+        label: [Run(name=f"{prefix}{i + 1}") for i in range(len(scores))]
+        for label, prefix, scores in (
+            ("TPG", "TPG-seed", tpg_scores),
+            ("TPG-robust", "TPG-robust-seed", robust_scores),
+        )
+    }
+    norm = {
+        run.name: dict(zip(tasks, row, strict=True))
+        for label, scores in (("TPG", tpg_scores), ("TPG-robust", robust_scores))
+        for run, row in zip(groups[label], scores, strict=True)
+    }
+    vs = {name: {t: v * vs_scale for t, v in n.items()} for name, n in norm.items()}
+    matrices = {
+        label: np.array([[norm[r.name][t] for t in tasks] for r in runs])
+        for label, runs in groups.items()
+    }
+    return rs.Comparison(tasks, groups, 1000, [], 0, norm, vs, matrices)
+
+
+def test_the_answer_says_not_yet_until_the_paper_s_counts_are_met():
+    import robust_section as rs
+
+    tpg = [[0.5, 0.4, 0.2]] * 4
+    robust = [[0.95, 0.4, 0.7], [0.92, 0.3, 0.8], [0.99, 0.95, 0.65], [0.9, 0.5, 0.1]]
+    [text] = rs.answer(_comparison(tpg, robust))
+    assert text.startswith("**Does it reproduce the paper? Not yet.**")
+    assert "0 of 4 TPG runs have an all-task champion" in text
+    assert "better in A and C and level in B" in text
+    # the best run by its worst task: seed 3, under 0.9 only in C
+    assert "best run (TPG-robust-seed3) scores 0.9 or more of the reference best in 2 of 3" in text
+    assert "and 0.65 in C (the paper's best run: at least 0.9 in 4 of 6" in text
+    assert "only 1 of 4 TPG-robust runs reaches 0.6 in all six tasks and none reaches 0.9" in text
+    assert text.endswith("B (IQM 0.45) and C (IQM 0.68) stay behind.")
+    assert "(the intervals apart)" in text  # TPG's runs are alike: its interval is a point
+    [same] = rs.answer(_comparison(robust, robust))
+    assert "(the intervals overlap), level in 3 tasks," in same
+    # half the runs at 0.6 and one in ten at 0.9 in every task: the paper's counts
+    [text] = rs.answer(_comparison(tpg, [[0.95, 0.95, 0.95], [0.7, 0.8, 0.9]]))
+    assert text.startswith("**Does it reproduce the paper? Yes.**")
+    assert "And 2 of 2 TPG-robust runs reach 0.6 in all six tasks and 1 reaches 0.9" in text
+
+
+def test_the_cost_is_cpu_time_per_generation_and_names_a_change_of_engine(tmp_path):
+    import subprocess
+
+    import results_text as rt
+
+    def commit(repo, message):
+        git = ["git", "-C", str(repo), "-c", "user.name=t", "-c", "user.email=t@t"]
+        subprocess.run([*git, "commit", "-q", "--allow-empty", "-m", message], check=True)
+        return subprocess.run(
+            [*git, "rev-parse", "HEAD"], check=True, capture_output=True, text=True
+        ).stdout.strip()
+
+    repo = tmp_path / "repo"
+    subprocess.run(["git", "init", "-q", str(repo)], check=True)
+    old, lanes, new = commit(repo, "old"), commit(repo, "lanes"), commit(repo, "new")
+    head = "from_generation,to_generation,mtpg_commit,started_utc,wall_s,cpu_s,workers\n"
+    runs = {}
+    for name, rows in (
+        ("a", [f"0,10,{old},t,5,30,1", f"10,20,{old},t,5,,1"]),  # no CPU time: left out
+        ("b", [f"0,30,{lanes},t,5,60,2"]),
+        ("c", [f"0,10,{new},t,5,20,1"]),
+    ):
+        runs[name] = tmp_path / name
+        runs[name].mkdir()
+        (runs[name] / "provenance.csv").write_text(head + "\n".join(rows) + "\n")
+    assert rt.cpu_seconds_per_generation([runs["a"], runs["b"]]) == 90 / 40
+    rt_lane = rt.LANE_ENGINE
+    try:
+        rt.LANE_ENGINE = lanes
+        note = rt.engine_note({"X": [runs["a"]], "Y": [runs["b"], runs["c"]]}, repo)
+        assert "X grew with engines before the lane engine; Y grew with the lane engine" in note
+        assert rt.engine_note({"X": [runs["b"]], "Y": [runs["c"]]}, repo) == ""  # the same
+        assert rt.engine_note({"X": [runs["a"]]}, tmp_path) == ""  # no git here: unsaid
+    finally:
+        rt.LANE_ENGINE = rt_lane

@@ -90,6 +90,23 @@ def _fig(name: str, caption: str) -> str:
     return f"![{caption}](figures/{name})\n\n*{caption}*\n"
 
 
+def _robust_figure(comparison, tpg, numbers, path: Path) -> Path:
+    """Both groups' IQM per task and over all tasks (the section's table, drawn)."""
+    from mtpg.analysis.runs import statistics as stats
+    from mtpg.analysis.runs.loading import RunGroup
+    from mtpg.analysis.runs.reported_numbers import run_numbers
+    from mtpg.analysis.runs.statistics_figures import aggregate
+
+    robust = comparison.groups["TPG-robust"]
+    groups = [tpg, RunGroup("TPG-robust", robust, {})]
+    drawn = {**numbers, **{r.path: run_numbers(r) for r in robust}}
+    estimates = {
+        label: (stats.per_task_iqm(m), stats.aggregate_iqm(m))
+        for label, m in comparison.matrices.items()
+    }
+    return aggregate(groups, drawn, estimates, path)
+
+
 def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
     """Writes the figures and ``README.md`` of ``results``; returns the README's path.
 
@@ -295,6 +312,9 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
 
             probes = {r.name: probe_target(r.path) for r in [*tpg.runs, *robust]}
         lines += robust_section(comparison, robust, probes, TARGET)
+        if comparison.complete:
+            _robust_figure(comparison, tpg, numbers, figures / "robust_vs_tpg.png")
+            lines.append(_fig("robust_vs_tpg.png", "TPG-robust beside TPG: IQM with 95% CIs"))
     lines += ["## Cost", ""]
     lines += [
         "Wall-clock hours: the sum of `metrics.csv`'s `t_total` (every generation, test "

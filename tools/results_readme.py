@@ -281,6 +281,8 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
         ("hierarchy.png", "Fig. 8: teams per decision by task subset"),
         ("aggregate.png", "Across seeds: IQM with 95% bootstrap confidence intervals"),
         ("performance_profile.png", "Across seeds: performance profile"),
+        ("probability_of_improvement.png", "Across seeds: probability of improvement"),
+        ("training_curves.png", "Training scores and population sizes, every generation"),
     ):
         if (figures / name).is_file():
             lines.append(_fig(name, caption))

@@ -47,6 +47,8 @@ def test_the_page_links_every_figure_it_draws_and_names_every_run(results):
     assert any(link.startswith("analysis/") for link in links)
     for link in links:
         assert (results / link).is_file(), link
+    drawn = {f"{p.parent.name}/{p.name}" for p in results.glob("*/*.png")}
+    assert drawn <= set(links), drawn - set(links)  # every figure drawn is on the page
     for name in ("TPG-seed1", "TPG-seed2", "TPG-NoMemory-seed1"):
         assert f"| {name} |" in text
     assert "**In progress**" in text  # 4 of 1,000 generations

@@ -419,7 +419,7 @@ def main(argv: list[str] | None = None) -> int:
                 running.append(job)
             for job in [j for j in running if j.poll()]:
                 running.remove(job)
-                print(f"{job.name}: ended ({job.status}) at {last_generation(job.path)}")
+                print(f"{job.name}: ended ({job.status}) at {job.end_gen}")
                 last = running[0] if len(running) == 1 and not todo else None
                 if last and last.workers < all_threads and not last.poll() and began(last):
                     # the last run takes the threads of those that finished: it commits

@@ -92,7 +92,6 @@ def _fig(name: str, caption: str) -> str:
 
 def _robust_figure(comparison, tpg, numbers, path: Path) -> Path:
     """Both groups' IQM per task and over all tasks (the section's table, drawn)."""
-    from mtpg.analysis.runs import statistics as stats
     from mtpg.analysis.runs.loading import RunGroup
     from mtpg.analysis.runs.reported_numbers import run_numbers
     from mtpg.analysis.runs.statistics_figures import aggregate
@@ -100,11 +99,7 @@ def _robust_figure(comparison, tpg, numbers, path: Path) -> Path:
     robust = comparison.groups["TPG-robust"]
     groups = [tpg, RunGroup("TPG-robust", robust, {})]
     drawn = {**numbers, **{r.path: run_numbers(r) for r in robust}}
-    estimates = {
-        label: (stats.per_task_iqm(m), stats.aggregate_iqm(m))
-        for label, m in comparison.matrices.items()
-    }
-    return aggregate(groups, drawn, estimates, path)
+    return aggregate(groups, drawn, comparison.estimates, path)
 
 
 def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:

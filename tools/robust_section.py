@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -105,17 +106,12 @@ def _runs(n: int) -> str:
     return f"{n} run" if n == 1 else f"{n} runs"
 
 
-def iqm_rows(matrices: dict[str, np.ndarray]) -> list[list[str]]:
-    """IQM [95% CI] per task and over all tasks, one row per group of (runs x tasks)."""
-    from mtpg.analysis.runs import statistics as stats
-
-    rows = []
-    for label, m in matrices.items():
-        per_task, overall = stats.per_task_iqm(m), stats.aggregate_iqm(m)
-        rows.append(
-            [f"{label} ({_runs(m.shape[0])})", *(e.text(2) for e in per_task), overall.text(2)]
-        )
-    return rows
+def iqm_rows(estimates: dict[str, tuple[list, object]]) -> list[list[str]]:
+    """IQM [95% CI] per task and over all tasks, one row per group (``Comparison.estimates``)."""
+    return [
+        [f"{label} ({_runs(overall.runs)})", *(e.text(2) for e in per_task), overall.text(2)]
+        for label, (per_task, overall) in estimates.items()
+    ]
 
 
 @dataclass(frozen=True)
@@ -146,6 +142,16 @@ class Comparison:
     def complete(self) -> bool:
         """All five TPG-robust runs have reached the target and are compared there."""
         return not self.growing and self.missing <= 0
+
+    @cached_property
+    def estimates(self) -> dict[str, tuple[list, object]]:
+        """Group -> (IQM per task, IQM over all tasks), each with its 95% interval."""
+        from mtpg.analysis.runs import statistics as stats
+
+        return {
+            label: (stats.per_task_iqm(m), stats.aggregate_iqm(m))
+            for label, m in self.matrices.items()
+        }
 
     def count(self, label: str, level: float) -> int:
         """Runs of a group whose all-task champion reaches ``level`` of the best single."""
@@ -183,10 +189,7 @@ def _per_task_verdict(c: Comparison) -> str:
     """TPG-robust's IQM per task against TPG's: "better in 5 tasks and level in X"."""
     from results_text import LEVEL
 
-    from mtpg.analysis.runs import statistics as stats
-
-    ours = stats.per_task_iqm(c.matrices["TPG-robust"])
-    theirs = stats.per_task_iqm(c.matrices["TPG"])
+    ours, theirs = c.estimates["TPG-robust"][0], c.estimates["TPG"][0]
     kinds: dict[str, list[str]] = {"better": [], "level": [], "worse": []}
     for task, a, b in zip(c.tasks, ours, theirs, strict=True):
         diff = a.value - b.value
@@ -210,10 +213,8 @@ def answer(c: Comparison) -> list[str]:
     """
     from results_text import PAPER
 
-    from mtpg.analysis.runs import statistics as stats
-
     n_tpg, n_rob = (len(c.groups[g]) for g in ("TPG", "TPG-robust"))
-    tpg, rob = (stats.aggregate_iqm(c.matrices[g]) for g in ("TPG", "TPG-robust"))
+    tpg, rob = (c.estimates[g][1] for g in ("TPG", "TPG-robust"))
     r06, r09 = c.count("TPG-robust", 0.6), c.count("TPG-robust", 0.9)
     yes = 2 * r06 >= n_rob and 10 * r09 >= n_rob
     apart = "the intervals apart" if rob.low > tpg.high else "the intervals overlap"
@@ -227,7 +228,7 @@ def answer(c: Comparison) -> list[str]:
     best_text = f"0.9 or more of the reference best in {len(high)} of {len(c.tasks)} tasks" + (
         f" and {_and([f'{scores[t]:.2f}' for t in low])} in {_and(low)}" if low else ""
     )
-    per_task = stats.per_task_iqm(c.matrices["TPG-robust"])
+    per_task = c.estimates["TPG-robust"][0]
     weak = sorted(zip(per_task, c.tasks, strict=True), key=lambda p: p[0].value)[:2]
     reaches = "reaches" if r06 == 1 else "reach"
     r09_text = "none reaches" if r09 == 0 else f"{r09} {'reaches' if r09 == 1 else 'reach'}"
@@ -312,7 +313,7 @@ def section(c: Comparison, robust, probes: dict, target: int) -> list[str]:
         "",
         f"Over seeds, interquartile mean [95% CI] ({STATS_NOTE}):",
         "",
-        *markdown_table(["group", *tasks, "all tasks"], iqm_rows(matrices)),
+        *markdown_table(["group", *tasks, "all tasks"], iqm_rows(c.estimates)),
         "",
     ]
     poi = stats.probability_of_improvement(matrices["TPG-robust"], matrices["TPG"])

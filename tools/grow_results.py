@@ -7,7 +7,7 @@ grow over many sittings, machines and commits. Each call of this script::
     .venv/bin/python tools/grow_results.py --budget 150          # minutes
 
 continues the unfinished runs of :data:`PLAN` (or, with ``--plan robust``, of
-:data:`ROBUST_PLAN` beside them; with ``--plan demo``, of
+:data:`ROBUST_PLAN` beside them, ``--plan authors`` of :data:`AUTHORS_PLAN`; with ``--plan demo``, of
 :data:`DEMO_PLAN` in ``results/candidates``, ``--plan variants`` of :data:`VARIANTS_PLAN` in
 ``results/variants``) in order, ``--parallel`` at a time, each an
 ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun) on
@@ -97,10 +97,18 @@ AUTHORS_TASKS = {
         "MountainCarContinuous[noise_high=pi;noise_low=-pi;obs_high=1;obs_low=0]"
     ),
 }
+#: TPG-authors at the paper's scale (issue 52, item 1): the ``paper`` preset (fixed training
+#: episodes, as the authors' code also has them) on the six tasks with the interface of the
+#: authors' code (:data:`AUTHORS_TASKS`), seeds 1 to 5, beside TPG and TPG-robust in
+#: ``results/runs`` (``--plan authors``).
+AUTHORS_PLAN: tuple[tuple[str, int, str | None], ...] = tuple(
+    (f"TPG-authors-seed{s}", s, "six-authors") for s in range(1, 6)
+)
 #: Each plan: its preset, and where its runs go unless ``--results`` says otherwise.
 PLANS = {
     "paper": ("paper", "results"),
     "robust": ("robust", "results"),
+    "authors": ("paper", "results"),
     "demo": ("demo", "results/candidates"),
     "variants": ("demo", "results/variants"),
 }
@@ -108,7 +116,13 @@ PLANS = {
 
 def plan_runs(plan: str) -> tuple[tuple[str, int, str | None], ...]:
     """The runs of a plan (looked up when called, so tests may replace a plan)."""
-    plans = {"paper": PLAN, "robust": ROBUST_PLAN, "demo": DEMO_PLAN, "variants": VARIANTS_PLAN}
+    plans = {
+        "paper": PLAN,
+        "robust": ROBUST_PLAN,
+        "authors": AUTHORS_PLAN,
+        "demo": DEMO_PLAN,
+        "variants": VARIANTS_PLAN,
+    }
     return plans[plan]
 
 
@@ -355,8 +369,8 @@ def main(argv: list[str] | None = None) -> int:
         "--plan",
         choices=sorted(PLANS),
         default="paper",
-        help="the paper's experiment (paper), TPG-robust (robust), the demo-scale candidates "
-        "(demo) or the interface study (variants)",
+        help="the paper's experiment (paper), TPG-robust (robust), TPG-authors (authors), "
+        "the demo-scale candidates (demo) or the interface study (variants)",
     )
     p.add_argument(
         "--results", type=Path, default=None, help="folder (results; demo: results/candidates)"

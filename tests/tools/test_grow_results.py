@@ -119,6 +119,28 @@ def test_the_demo_plan_starts_demo_runs_with_and_without_resampling(tmp_path, mo
     assert all("resample10" in c[c.index("--out") + 1] for c in resampled)
 
 
+def test_the_authors_plan_starts_paper_runs_with_the_authors_interface(tmp_path, monkeypatch):
+    tool = _tool()
+    started = []
+
+    class FakePopen:
+        def __init__(self, cmd, **_kw):
+            started.append(cmd)
+
+    monkeypatch.setattr(tool.subprocess, "Popen", FakePopen)
+    (tmp_path / "runs").mkdir()
+    args = tool.argparse.Namespace(
+        results=tmp_path, generations=1000, workers=1, train_arg=[], python="py", plan="authors"
+    )
+    for name, seed, variant in tool.plan_runs("authors"):
+        tool.start(name, seed, variant, args)
+    assert len(started) == 5 and {c[c.index("--seed") + 1] for c in started} == set("12345")
+    assert all(c[c.index("--preset") + 1] == "paper" for c in started)
+    tasks = {c[c.index("--tasks") + 1] for c in started}
+    assert tasks == {",".join(tool.AUTHORS_TASKS.values())}
+    assert all("TPG-authors-seed" in c[c.index("--out") + 1] for c in started)
+
+
 def test_the_last_run_left_takes_the_threads_of_the_runs_that_finished(
     tmp_path, monkeypatch, capsys
 ):

@@ -7,9 +7,9 @@ grow over many sittings, machines and commits. Each call of this script::
     .venv/bin/python tools/grow_results.py --budget 150          # minutes
 
 continues the unfinished runs of :data:`PLAN` (or, with ``--plan robust``, of
-:data:`ROBUST_PLAN` beside them, ``--plan authors`` of :data:`AUTHORS_PLAN`; with ``--plan demo``, of
-:data:`DEMO_PLAN` in ``results/candidates``, ``--plan variants`` of :data:`VARIANTS_PLAN` in
-``results/variants``) in order, ``--parallel`` at a time, each an
+:data:`ROBUST_PLAN` beside them, ``--plan authors`` of :data:`AUTHORS_PLAN`; with
+``--plan demo``, of :data:`DEMO_PLAN` in ``results/candidates``, ``--plan variants`` of
+:data:`VARIANTS_PLAN` in ``results/variants``) in order, ``--parallel`` at a time, each an
 ordinary ``mtpg train --resume`` process (``mtpg train --out`` for a run not begun) on
 ``--workers`` threads. The last run left takes the threads of the runs that finished
 (``--parallel`` times ``--workers``): it commits the generation under way and resumes on

@@ -9,6 +9,7 @@ continuation differ from an uninterrupted run of the commit that started it
 import json
 import shutil
 
+from mtpg.io.runschema import SCHEMA_FILE, UNVERSIONED, read_schema
 from paperpin import (
     END,
     MID,
@@ -43,3 +44,5 @@ def test_the_pinned_checkpoint_resumes_exactly(tmp_path):
     assert metrics_without_timing(run / "metrics.csv") == rows
     assert (run / "tests.csv").read_text() == (PIN / "expected" / "tests.csv").read_text()
     assert state_digest(run, END) == digests[str(END)]
+    # written before format.json existed, the run now records the version it is
+    assert (run / SCHEMA_FILE).is_file() and read_schema(run) == UNVERSIONED

@@ -5,6 +5,7 @@ from pathlib import Path
 
 from mtpg.analysis.graph.replay import SCHEMA_VERSION
 from mtpg.io.checkpoint import CHECKPOINT_FORMAT, CHECKPOINT_VERSION
+from mtpg.io.runschema import READABLE_VERSIONS, RUN_FORMAT, RUN_SCHEMA_VERSION, UNVERSIONED
 from mtpg.io.serialize import GRAPH_FORMAT, GRAPH_VERSION, POPULATION_FORMAT, POPULATION_VERSION
 from mtpg.model.instructions import CONSTANTS, OP_NAMES, RegisterLayout, disassemble
 
@@ -30,3 +31,9 @@ def test_register_ranges_and_versions():
     assert f"`{CHECKPOINT_FORMAT}`, {CHECKPOINT_VERSION}" in DOC
     assert f"`{POPULATION_FORMAT}`, {POPULATION_VERSION}" in DOC
     assert f"`schema_version` {SCHEMA_VERSION}" in DOC
+    assert (
+        f"`{RUN_FORMAT}`, {RUN_SCHEMA_VERSION} (a run without `format.json` is {UNVERSIONED})"
+        in DOC
+    )
+    assert f'{{"format": "{RUN_FORMAT}", "version": {RUN_SCHEMA_VERSION}}}' in DOC
+    assert READABLE_VERSIONS == (1,)  # the page says only version 1 is read; update it too

@@ -26,7 +26,8 @@ def test_init_new_run(tmp_path):
     assert run.config.read_text() == TOML
     assert run.checkpoints.is_dir() and run.champions.is_dir()
     assert is_run_dir(run.path)
-    assert sorted(p.name for p in run.path.iterdir()) == ["champions", "checkpoints", "config.toml"]
+    names = sorted(p.name for p in run.path.iterdir())
+    assert names == ["champions", "checkpoints", "config.toml", "format.json"]
     # an empty existing directory is fine too
     (tmp_path / "empty").mkdir()
     assert is_run_dir(init_run_dir(tmp_path / "empty", TOML).path)
@@ -37,7 +38,8 @@ def test_init_refuses_existing_run_unless_resuming(tmp_path):
     # a run that committed nothing may be started again (its creation is redone)
     (run.path / "metrics.csv").write_text("generation\n")
     init_run_dir(run.path, TOML)
-    assert sorted(p.name for p in run.path.iterdir()) == ["champions", "checkpoints", "config.toml"]
+    names = sorted(p.name for p in run.path.iterdir())
+    assert names == ["champions", "checkpoints", "config.toml", "format.json"]
     (run.checkpoints / "gen-000001.json.gz").write_bytes(b"")
     with pytest.raises(RunDirError, match="already holds an mtpg run"):
         init_run_dir(run.path, TOML)

@@ -109,6 +109,7 @@ def test_leftovers_of_a_run_that_committed_nothing_are_cleared_but_the_lock(tmp_
         "champions",
         "checkpoints",
         "config.toml",
+        "format.json",
     ]
     assert (run / "config.toml").read_text() == "seed = 2\n"
     assert (run / LOCK_FILE).read_text() == "12 host\n"

@@ -7,10 +7,14 @@ from pathlib import Path
 
 from mtpg.config import ConfigError, RunConfig, from_dict
 from mtpg.io.rundir import RunDir, check_resumable, check_run
+from mtpg.io.runschema import check_schema
 
 
 def read_run_config(run_dir: str | Path, resuming: bool = False) -> RunConfig:
     """Reads the resolved configuration stored in a run directory.
+
+    The directory's schema version is checked first (:func:`mtpg.io.runschema.check_schema`),
+    so a run written by a newer mtpg is refused in one line naming both versions.
 
     Args:
         run_dir: The run directory.
@@ -19,6 +23,7 @@ def read_run_config(run_dir: str | Path, resuming: bool = False) -> RunConfig:
 
     Raises:
         RunDirError: When ``run_dir`` holds no run (the message says why).
+        RunSchemaError: When the run is of a schema version this mtpg does not read.
         ConfigError: When its ``config.toml`` cannot be read or is not valid.
     """
     path = RunDir(Path(run_dir)).config
@@ -33,6 +38,7 @@ def read_run_config(run_dir: str | Path, resuming: bool = False) -> RunConfig:
     except (OSError, UnicodeDecodeError) as exc:
         why = exc.strerror if isinstance(exc, OSError) else "not UTF-8 text"
         raise ConfigError(f"{path}: cannot read: {why}") from exc
+    check_schema(run_dir)
     try:
         return from_dict(tomllib.loads(text))
     except (tomllib.TOMLDecodeError, ConfigError) as exc:

@@ -2,6 +2,7 @@
 
 Layout::
 
+    RUN_DIR/format.json        the schema version of the directory (mtpg.io.runschema)
     RUN_DIR/config.toml        the resolved configuration of the run
     RUN_DIR/metrics.csv        one row per generation (fixed header)
     RUN_DIR/checkpoints/       gen-NNNNNN.json.gz (see mtpg.io.checkpoint)
@@ -28,6 +29,7 @@ from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
 from mtpg.io.checkpoint import CHECKPOINT_DIR
 from mtpg.io.lock import LOCK_FILE
+from mtpg.io.runschema import SCHEMA_FILE, check_schema, stamp_schema, write_schema
 from mtpg.io.serialize import load_graph, save_graph
 from mtpg.model.graph import Population
 
@@ -82,6 +84,7 @@ def is_run_dir(path: str | os.PathLike[str]) -> bool:
 #: run that committed nothing (or whose creation was interrupted), which may be restarted.
 RUN_NAMES = frozenset(
     {
+        SCHEMA_FILE,
         CONFIG_FILE,
         METRICS_FILE,
         CHECKPOINT_DIR,
@@ -157,10 +160,12 @@ def init_run_dir(
 
     A new run needs a missing or empty directory, or one a run left without committing
     anything (see :func:`check_new_run_dir`; its leftovers are cleared). Creation writes
-    ``checkpoints/`` and ``champions/`` first and ``config.toml`` (atomically) last, so
-    a directory is a run exactly when its creation completed. Resuming needs an existing
-    run; its ``config.toml`` is replaced by ``config_toml`` when given (the caller checks
-    that the change is compatible) and kept when ``config_toml`` is None.
+    ``checkpoints/``, ``champions/`` and ``format.json`` (the schema version) first and
+    ``config.toml`` (atomically) last, so a directory is a run exactly when its creation
+    completed. Resuming needs an existing run of a schema this mtpg reads (one without
+    ``format.json`` gets it, see :mod:`mtpg.io.runschema`); its ``config.toml`` is
+    replaced by ``config_toml`` when given (the caller checks that the change is
+    compatible) and kept when ``config_toml`` is None.
 
     The caller holds the directory's lock (:mod:`mtpg.io.lock`) when other processes may
     use it.
@@ -177,10 +182,12 @@ def init_run_dir(
         RunDirError: When ``path`` is a file, a non-empty directory that is not a run,
             already holds a run (and ``resume`` is False) or holds none (and ``resume``
             is True).
+        RunSchemaError: On resume, when the run is of a schema this mtpg does not read.
     """
     run = RunDir(Path(path))
     if resume:
         check_resumable(run.path)
+        check_schema(run.path)
     else:
         if config_toml is None:
             raise RunDirError(f"{run.path}: a new run needs its configuration")
@@ -190,6 +197,10 @@ def init_run_dir(
         point("create", 0)
     run.checkpoints.mkdir(exist_ok=True)
     run.champions.mkdir(exist_ok=True)
+    if resume:
+        stamp_schema(run.path)
+    else:
+        write_schema(run.path)
     if config_toml is not None:
         atomic_write_bytes(run.config, config_toml.encode("utf-8"))
     if not resume:

@@ -427,8 +427,8 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "kernel-continuous-output-register",
         "src/mtpg/engine/episode_kernels.py",
-        "return -1 - act, W[u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m]",
-        "return -1 - act, W[u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m + np.uint64(1)]",
+        "return -1 - act, np.int64(u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m)",
+        "return -1 - act, np.int64(u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m + one)",
         _ENGINE,
     ),
     # the paper's selection rule (section 4.1) and the validated champion choice

@@ -205,7 +205,7 @@ CASES = [
     (["evaluate", "{G}", "--workers", "0"], 2, "--workers must be in 1.."),
     (["evaluate", "{G}", "--tasks", ""], 2, "--tasks: empty list"),
     (["evaluate", "{G}", "--tasks", "Pong"], 2, "unknown task 'Pong'"),
-    (["evaluate", "{nobs1.json}"], 2, "layout.n_obs must be 2"),
+    (["evaluate", "{nobs1.json}"], 2, "layout.n_obs must be >= 2 to play the registered"),
     (["evaluate", "{bigid.json}"], 2, "must fit a 64-bit integer"),
     (["evaluate", "{hugeid.json}"], 2, "must fit a 64-bit integer"),
     (["evaluate", "{regs.json}"], 2, "layout.n_memory must be <= 256"),

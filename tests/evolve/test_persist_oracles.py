@@ -106,7 +106,7 @@ def test_layout_must_match_the_configuration_from_generation_one(payload) -> Non
     del data["run"]
     message = refused(data)
     assert message.startswith("run state: population layout RegisterLayout(n_registers=8")
-    assert message.endswith(f"does not match the configuration (4, 8, {N_OBS})")
+    assert message.endswith(f"does not match the configuration (4, 8, {N_OBS}, 3)")
 
 
 def test_scores_must_have_one_entry_per_task(payload) -> None:

@@ -165,7 +165,7 @@ def _graph(two_runs):
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        (lambda g: g["layout"].update(n_obs=1), "layout.n_obs must be 2"),
+        (lambda g: g["layout"].update(n_obs=10**6), "layout.n_obs must be <= 65536"),
         (lambda g: g["layout"].update(n_registers=10**6), "layout.n_registers must be <= 256"),
         (lambda g: g["teams"][0].update(id=2**63), "must fit a 64-bit integer"),
         (lambda g: g.update(root=2**64), "must fit a 64-bit integer"),

@@ -98,14 +98,18 @@ def run(args: argparse.Namespace) -> int:
     header = f"{'task':<{width}} {'mean':>10} {'std':>9} {'normalised':>10} {'teams/dec':>9}"
     print(header + (f" {'vs single':>9}" if single else ""))
     for t, s in scores.items():
-        line = (
-            f"{t:<{width}} {s.mean:>10.3f} {s.std:>9.3f} {s.normalised:>10.3f} "
-            f"{s.teams_per_decision:>9.2f}"
-        )
+        norm = f"{s.normalised:>10.3f}" if s.normalised == s.normalised else f"{'n/a':>10}"
+        line = f"{t:<{width}} {s.mean:>10.3f} {s.std:>9.3f} {norm} {s.teams_per_decision:>9.2f}"
         if t in single:
             v = out[t]["normalised_single_task"]
             line += f" {v:>9.3f}" if v == v else f" {'n/a':>9}"  # n/a: champion = random
         print(line)
+    raw = [t for t, s in scores.items() if s.normalised != s.normalised]
+    if raw:  # a task without a reference best (a Gymnasium task with none given)
+        print(
+            f"raw scores (no reference best given) for {', '.join(raw)}: give one as "
+            'evaluation.references = ["TASK: best=NUMBER, source=TEXT"]'
+        )
     return 0
 
 

@@ -22,6 +22,8 @@ import time
 from pathlib import Path
 from typing import TextIO
 
+from mtpg.envs.specs.gym_task import is_gym
+from mtpg.envs.specs.gym_task import short as gym_short
 from mtpg.envs.specs.registry import TASKS
 from mtpg.evolve.trainer import Generation, Reporter
 
@@ -30,13 +32,20 @@ from mtpg.evolve.trainer import Generation, Reporter
 SHORT = {t.name: t.short for t in TASKS}
 
 
+def _short(task: str) -> str:
+    """A task's short label: the registry's, a variant its base's, a ``gym:`` task its own."""
+    if is_gym(task):
+        return gym_short(task)
+    return SHORT[task.split("[", 1)[0]]
+
+
 def short_names(tasks: tuple[str, ...] | list[str]) -> dict[str, str]:
     """The status line's label of each task.
 
     A task's short name, a variant its base's; labels that repeat in the run are numbered
     in run order (``CP1``, ``CP2``).
     """
-    base = {t: SHORT[t.split("[", 1)[0]] for t in tasks}
+    base = {t: _short(t) for t in tasks}
     labels = list(base.values())
     out, seen = {}, dict.fromkeys(labels, 0)
     for t in tasks:

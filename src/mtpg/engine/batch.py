@@ -13,9 +13,11 @@ import numpy as np
 
 from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.episode_kernels import run_jobs_parallel, run_jobs_queue
+from mtpg.engine.gym_play import play_gym
 from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_parallel, run_lanes_queue
+from mtpg.envs.specs.gym_task import TRAIN_RESET_OFFSET
 from mtpg.envs.taskset.episodes import draw_episodes
-from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.task_table import BUILTIN_SHAPE, GYM_ID_BASE, REGISTERED, TaskTable
 
 
 class Episodes(NamedTuple):
@@ -30,6 +32,11 @@ class Episodes(NamedTuple):
             ``noise`` (:func:`mtpg.envs.taskset.episodes.draw_episodes`), or ``[n, 0, 2]``.
         params: float64 ``[ids, N_PARAMS]``: the parameter table the task ids index
             (the ``params`` of the task table the episodes were drawn from).
+
+    A table of a task table with Gymnasium tasks is a :class:`GymEpisodes`, which also
+    holds those tasks (:attr:`gym`); :func:`run_jobs` plays their rows from Python
+    (:mod:`mtpg.engine.gym_play`; a row's seed is its ``reset`` seed) and hands the
+    compiled kernels a plain :class:`Episodes` (:meth:`compiled`).
     """
 
     tasks: np.ndarray
@@ -45,7 +52,16 @@ class Episodes(NamedTuple):
         tasks = np.asarray(tasks, dtype=np.int64)
         seeds = np.asarray(seeds, dtype=np.int64)
         starts, noise, obs_noise = draw_episodes(tasks, seeds, table)
-        return cls(tasks, seeds, starts, noise, obs_noise, table.params)
+        fields = (tasks, seeds, starts, noise, obs_noise, table.params)
+        return GymEpisodes.holding(fields, table.gym) if table.gym else Episodes(*fields)
+
+    @property
+    def gym(self) -> tuple:
+        """The Gymnasium tasks of the table (``()`` for compiled tasks alone).
+
+        Task ``k`` (:class:`~mtpg.envs.specs.gym_task.GymTask`) has id ``GYM_ID_BASE + k``.
+        """
+        return getattr(self, "__dict__", {}).get("gym_tasks", ())
 
     @classmethod
     def single(
@@ -73,15 +89,49 @@ class Episodes(NamedTuple):
 
     @classmethod
     def grid(
-        cls, tasks: list[int], seeds: list[int] | np.ndarray, table: TaskTable = REGISTERED
+        cls,
+        tasks: list[int],
+        seeds: list[int] | np.ndarray,
+        table: TaskTable = REGISTERED,
+        training: bool = False,
     ) -> Episodes:
-        """Every task with every seed, task-major: episode ``i * len(seeds) + k``."""
+        """Every task with every seed, task-major: episode ``i * len(seeds) + k``.
+
+        With ``training``, a Gymnasium task's seeds below ``TRAIN_RESET_OFFSET`` are
+        offset by it (:mod:`mtpg.envs.specs.gym_task`), so no test seed below 10**9 replays a
+        training episode; the compiled tasks' seeds are as given.
+        """
         seeds = np.asarray(seeds, dtype=np.int64)
-        return cls.make(
-            np.repeat(np.asarray(tasks, dtype=np.int64), len(seeds)),
-            np.tile(seeds, len(tasks)),
-            table,
-        )
+        task_col = np.repeat(np.asarray(tasks, dtype=np.int64), len(seeds))
+        seed_col = np.tile(seeds, len(tasks))
+        if training:
+            shift = (task_col >= GYM_ID_BASE) & (seed_col < TRAIN_RESET_OFFSET)
+            seed_col = np.where(shift, seed_col + TRAIN_RESET_OFFSET, seed_col)
+        return cls.make(task_col, seed_col, table)
+
+    def with_noise(self, noise: np.ndarray) -> Episodes:
+        """The same table with another noise matrix (its Gymnasium tasks kept)."""
+        fields = (*self[:3], noise, *self[4:])
+        return GymEpisodes.holding(fields, self.gym) if self.gym else Episodes(*fields)
+
+    def compiled(self) -> Episodes:
+        """The table as the compiled kernels take it (a plain :class:`Episodes`)."""
+        return Episodes(*self) if type(self) is not Episodes else self
+
+
+class GymEpisodes(Episodes):
+    """An :class:`Episodes` table that also holds its task table's Gymnasium tasks.
+
+    The tasks are an attribute, not a field, so the compiled kernels' argument type stays
+    the six arrays (they are given :meth:`Episodes.compiled`).
+    """
+
+    @classmethod
+    def holding(cls, fields: tuple, gym: tuple) -> GymEpisodes:
+        """The table of ``fields`` holding the Gymnasium tasks ``gym``."""
+        table = cls(*fields)
+        table.__dict__["gym_tasks"] = tuple(gym)
+        return table
 
 
 class Jobs(NamedTuple):
@@ -159,6 +209,9 @@ def run_jobs(
         raise ValueError(f"block must be >= 1, got {block}")
     if lanes < 0:
         raise ValueError(f"lanes must be >= 0, got {lanes}")
+    if episodes.gym:
+        return _run_mixed(cp, job_roots, job_episodes, episodes, threads, no_memory, block, lanes)
+    check_fits_compiled_tasks(cp)
     out = BatchResult.zeros(len(job_roots))
     jobs = Jobs(
         np.ascontiguousarray(job_roots, dtype=np.int64),
@@ -177,6 +230,50 @@ def run_jobs(
             run_jobs_parallel(threads, queue, block, jobs, episodes, out, g)
         else:
             run_lanes_parallel(threads, queue, block, lanes, jobs, episodes, out, g)
+    return out
+
+
+def check_fits_compiled_tasks(cp: CompiledPopulation) -> None:
+    """Refuses a graph the compiled tasks cannot play (they observe 2 inputs, take 3 actions).
+
+    Raises:
+        ValueError: One line naming the layout size at fault.
+    """
+    n_obs, n_actions, _ = BUILTIN_SHAPE
+    if cp.layout.n_obs < n_obs:
+        raise ValueError(
+            f"layout.n_obs must be >= {n_obs} to play the registered tasks "
+            f"(they observe {n_obs} inputs), got {cp.layout.n_obs}"
+        )
+    if cp.layout.n_actions > n_actions:
+        raise ValueError(
+            f"layout.n_actions must be <= {n_actions} to play the registered tasks "
+            f"(they take {n_actions} atomic actions), got {cp.layout.n_actions}"
+        )
+
+
+def _run_mixed(cp, job_roots, job_episodes, episodes, threads, no_memory, block, lanes):
+    """:func:`run_jobs` for a table with Gymnasium tasks: their jobs step in Python."""
+    job_roots = np.asarray(job_roots, dtype=np.int64)
+    job_episodes = np.asarray(job_episodes, dtype=np.int64)
+    out = BatchResult.zeros(len(job_roots))
+    gym_job = episodes.tasks[job_episodes] >= GYM_ID_BASE
+    table = episodes.compiled()
+    if not gym_job.all():
+        mine = ~gym_job
+        done = run_jobs(
+            cp, job_roots[mine], job_episodes[mine], table, threads, no_memory, block, lanes
+        )
+        for field, values in zip(out, done, strict=True):
+            field[mine] = values
+    cp = cp.with_memory_mode(no_memory)
+    for k, task in enumerate(episodes.gym):
+        mine = np.flatnonzero(gym_job & (episodes.tasks[job_episodes] == GYM_ID_BASE + k))
+        if len(mine):
+            seeds = episodes.seeds[job_episodes[mine]]
+            done = play_gym(cp, job_roots[mine], task, seeds)
+            for field, values in zip(out, done, strict=True):
+                field[mine] = values
     return out
 
 

@@ -6,7 +6,8 @@ compiled graph (:class:`~mtpg.engine.compile.Graph`), the jobs and the episode t
 (:class:`~mtpg.engine.batch.BatchResult`) and one thread's private :class:`Buffers`, whose
 float64 workspace ``W`` is laid out as documented in :mod:`mtpg.engine.compile`.
 
-The scalar decision semantics live in :func:`decide` alone and the scalar episode loop
+The scalar decision semantics live in :func:`decide_bank` alone (:func:`decide` reads its
+continuous output) and the scalar episode loop
 in :func:`run_jobs_queue` alone (the lane engine, :mod:`mtpg.engine.lanes`, plays many
 episodes at once and is tested to match them job by job): the tracer
 (:mod:`mtpg.engine.trace`) runs the same two with
@@ -109,9 +110,10 @@ def thread_buffers(g) -> Buffers:
     K = len(g.folded)
     for i in range(K):  # the folded constants, just below bank 0
         W[base - K + i] = g.folded[i]
+    n_obs = base - K - (R + N_CONSTANTS)  # the layout's observed inputs
     return Buffers(
         W,
-        W[R + N_CONSTANTS : R + N_CONSTANTS + 2],
+        W[R + N_CONSTANTS : R + N_CONSTANTS + n_obs],
         np.full(len(g.team_offsets) - 1, -1, dtype=np.int64),
         np.full(n_banks, -1, dtype=np.int64),
         np.zeros(STATE_SIZE),
@@ -121,6 +123,17 @@ def thread_buffers(g) -> Buffers:
 
 @njit(cache=True, error_model="numpy", inline="always")
 def decide(g, buf, root, stamp, episode, rec):
+    """Makes one decision (:func:`decide_bank`) and reads ``m[0]`` of the winner's bank.
+
+    Returns:
+        ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
+    """
+    a_d, off = decide_bank(g, buf, root, stamp, episode, rec)
+    return a_d, buf.W[np.uint64(off)]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def decide_bank(g, buf, root, stamp, episode, rec):
     """Makes one decision: traverses the graph from ``root`` to an atomic action.
 
     Written as one flat loop nest on purpose: helper functions taking arrays cost an
@@ -142,7 +155,8 @@ def decide(g, buf, root, stamp, episode, rec):
         rec: ``None``, or the :class:`~mtpg.engine.record.Recorder` to log into.
 
     Returns:
-        ``(a_d, a_c)``: the final program's atomic action and ``m[0]`` of its bank.
+        ``(a_d, off)``: the final program's atomic action and the workspace index of
+        ``m[0]`` of its bank (the continuous outputs are ``W[off + j]``).
     """
     team_offsets, team_members, prog_offsets = g.team_offsets, g.team_members, g.prog_offsets
     instrs, prog_action, prog_bank, prog_count = g.instrs, g.prog_action, g.prog_bank, g.prog_count
@@ -204,7 +218,7 @@ def decide(g, buf, root, stamp, episode, rec):
         if act < 0:
             counts[0] += n_teams
             counts[1] += np.int64(n_instr)
-            return -1 - act, W[u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m]
+            return -1 - act, np.int64(u_base + np.uint64(prog_bank[np.uint64(best_p)]) * u_m)
         team = np.uint64(act)
 
 

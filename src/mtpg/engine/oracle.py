@@ -70,12 +70,15 @@ class Decision:
         continuous: The continuous action ``a_c``.
         teams: Team ids visited, in order.
         bids: ``(program id, bid)`` of every program executed, in order.
+        bank: Id of the final program's memory bank (continuous output ``j`` is its
+            ``m[j]``).
     """
 
     action: int
     continuous: float
     teams: list[int] = field(default_factory=list)
     bids: list[tuple[int, float]] = field(default_factory=list)
+    bank: int = -1
 
 
 class ReferenceAgent:
@@ -131,8 +134,13 @@ class ReferenceAgent:
         return r[0]
 
     def act(self, obs: np.ndarray | list[float]) -> Decision:
-        """Makes one decision for observation ``obs``."""
+        """Makes one decision for observation ``obs``.
+
+        An observation shorter than the layout's inputs leaves the rest at 0 (a program
+        reading an input its task lacks reads 0).
+        """
         obs = [float(x) for x in obs]
+        obs += [0.0] * (self.pop.layout.n_obs - len(obs))
         visited: set[int] = set()
         decision = Decision(action=-1, continuous=0.0)
         team_id = self.root
@@ -151,6 +159,7 @@ class ReferenceAgent:
             if winner.is_atomic:
                 decision.action = winner.atomic_action
                 decision.continuous = self.bank(winner.bank)[0]
+                decision.bank = winner.bank
                 return decision
             team_id = winner.action
 

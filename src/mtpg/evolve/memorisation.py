@@ -51,7 +51,10 @@ SETS = ("train", "fresh_noise", "test")
 
 def observes_noise(task: str) -> bool:
     """Whether a task's second input is the U[0, 1] noise input (one observed variable)."""
-    return len(TaskTable.from_names([task]).specs[0].observed_slots) < 2
+    table = TaskTable.from_names([task])
+    if table.is_gym(table.ids[0]):  # a Gymnasium task has no noise input
+        return False
+    return len(table.specs[0].observed_slots) < 2
 
 
 def training_block(config: RunConfig, generation: int) -> int:
@@ -125,10 +128,13 @@ def fresh_noise_episodes(
     seeds = np.asarray(seeds, dtype=np.int64)
     table = TaskTable.from_names(tasks) if table is None else table
     ids = [table.id_of(t) for t in tasks]
-    grid = Episodes.grid(ids, np.tile(seeds, redraws), table)
+    grid = Episodes.grid(ids, np.tile(seeds, redraws), table, training=True)
     noise = np.zeros_like(grid.noise)
     row = 0
     for spec in (table.spec(i) for i in ids):
+        if table.is_gym(table.id_of(spec.name)):  # nothing to redraw: (b) replays (a)
+            row += redraws * len(seeds)
+            continue
         key = zlib.crc32(spec.name.encode("utf-8"))
         width = spec.max_steps + 1
         for r in range(redraws):
@@ -136,7 +142,7 @@ def fresh_noise_episodes(
                 seq = np.random.SeedSequence(noise_seed, spawn_key=(NOISE_SPAWN_TAG, r, key, s))
                 noise[row, :width] = np.random.default_rng(seq).random(width)
                 row += 1
-    return grid._replace(noise=noise)
+    return grid.with_noise(noise)
 
 
 @dataclass(frozen=True)
@@ -259,7 +265,7 @@ def probe_graph(
     play = local_evaluate(workers)
     cp = compile_population(pop, no_memory=no_memory)
     tables = (
-        Episodes.grid(ids, train_seeds, table),
+        Episodes.grid(ids, train_seeds, table, training=True),
         fresh_noise_episodes(tasks, train_seeds, noise_seed, redraws, table),
         Episodes.grid(ids, held_out_seeds(test_episodes, test_offset), table),
     )

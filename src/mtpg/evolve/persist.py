@@ -15,7 +15,6 @@ from typing import Any
 import numpy as np
 
 from mtpg.config import EXTENSIONS, ConfigError, RunConfig, from_dict, to_dict
-from mtpg.envs.specs.contract import N_OBS
 from mtpg.evolve.state import TrainerState
 from mtpg.io.serialize import FormatError, population_from_dict, population_to_dict
 
@@ -168,8 +167,10 @@ def _check_consistent(state: TrainerState, payload: dict[str, Any]) -> None:
     if state.generation < 0:
         raise FormatError(f"run state: generation must be >= 0, got {state.generation}")
     layout = pop.layout
-    want = (cfg.program.n_registers, cfg.program.n_memory, N_OBS)
-    if state.generation > 0 and (layout.n_registers, layout.n_memory, layout.n_obs) != want:
+    n_obs, n_actions, _ = cfg.evaluation.task_table().shape
+    want = (cfg.program.n_registers, cfg.program.n_memory, n_obs, n_actions)
+    have = (layout.n_registers, layout.n_memory, layout.n_obs, layout.n_actions)
+    if state.generation > 0 and have != want:
         raise FormatError(
             f"run state: population layout {layout} does not match the configuration {want}"
         )

@@ -84,7 +84,8 @@ class Trainer:
         if self._block is None or self._block[0] != block:
             ev = self.config.evaluation
             seeds = resampled_training_seeds(self.config.seed, block, ev.train_episodes)
-            self._block = (block, Episodes.grid(self.task_ids, seeds, self.tasks))
+            table = Episodes.grid(self.task_ids, seeds, self.tasks, training=True)
+            self._block = (block, table)
         return self._block[1]
 
     def compile(self) -> CompiledPopulation:

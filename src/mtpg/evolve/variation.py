@@ -12,7 +12,7 @@ from bisect import bisect_left
 import numpy as np
 
 from mtpg.config import ProgramConfig, RunConfig, TeamConfig
-from mtpg.model.graph import N_ACTIONS, Population, atomic
+from mtpg.model.graph import Population, atomic
 from mtpg.model.instructions import RegisterLayout, random_instructions
 
 #: Random instructions drawn at once by an :class:`InstructionPool` (part of the run's
@@ -57,7 +57,8 @@ def init_population(config: RunConfig, rng: np.random.Generator) -> Population:
     Every program gets its own new memory bank, a random atomic action and a length
     uniform in 1..``init_max_length``.
     """
-    layout = RegisterLayout(config.program.n_registers, config.program.n_memory)
+    n_obs, n_actions, _ = config.evaluation.task_table().shape
+    layout = RegisterLayout(config.program.n_registers, config.program.n_memory, n_obs, n_actions)
     pop = Population(layout=layout)
     pool = InstructionPool(rng, layout)
     for _ in range(config.team.root_size):
@@ -65,7 +66,7 @@ def init_population(config: RunConfig, rng: np.random.Generator) -> Population:
         for _ in range(config.team.init_team_size):
             length = int(rng.integers(1, config.program.init_max_length + 1))
             code = pool.take(length)
-            action = atomic(int(rng.integers(0, N_ACTIONS)))
+            action = atomic(int(rng.integers(0, layout.n_actions)))
             pids.append(pop.add_program(code, action, pop.new_bank()).id)
         pop.add_team(pids, birth=0)
     return pop
@@ -239,7 +240,7 @@ class Varier:
         """
         rng = self.rng
         if force_atomic or not self.targets or rng.random() < self.cfg.p_atomic:
-            return atomic(int(rng.integers(0, N_ACTIONS)))
+            return atomic(int(rng.integers(0, self.pop.layout.n_actions)))
         target = self.targets[int(rng.integers(0, len(self.targets)))]
         if target in self.roots:
             clone = self.pop.add_team(list(self.pop.teams[target].programs), self.generation)

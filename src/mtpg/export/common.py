@@ -46,8 +46,18 @@ TABLE_CONSTANTS: dict[str, float] = {
     "DIV_EPS": DIV_EPS,
 }
 
-#: Observations every task provides (the API of the generated code is fixed to two).
+#: Observations of the paper's tasks (the generated code takes ``layout.n_obs``).
 N_OBS = 2
+
+
+def action_text(n_actions: int) -> str:
+    """The atomic actions as the generated code's comments name them (``0, 1 or 2``)."""
+    if n_actions == 1:
+        return "0"
+    names = [str(a) for a in range(n_actions)]
+    if n_actions > 4:
+        names = ["0", "...", str(n_actions - 1)]
+    return ", ".join(names[:-1]) + " or " + names[-1]
 
 
 @dataclass(frozen=True)
@@ -154,14 +164,11 @@ def prepare(
         The reduced graph.
 
     Raises:
-        ValueError: When ``root`` is not a team of ``pop`` or the layout does not have
-            exactly two observations.
+        ValueError: When ``root`` is not a team of ``pop``.
     """
     if root not in pop.teams:
         raise ValueError(f"root team {root} is not in the population")
     layout = pop.layout
-    if layout.n_obs != N_OBS:
-        raise ValueError(f"layout.n_obs must be {N_OBS} for export, got {layout.n_obs}")
     team_ids = pop.reachable(root)
     team_index = {tid: k for k, tid in enumerate(team_ids)}
     prog_ids = list(dict.fromkeys(pid for tid in team_ids for pid in pop.teams[tid].programs))

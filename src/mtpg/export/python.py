@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram
+from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, action_text
 from mtpg.export.fold import Operand
 
 #: Expression of each protected operation (``d`` target, ``a``/``b`` operands).
@@ -99,12 +99,18 @@ def _team_function(graph: ExportGraph, t: int) -> str:
     return "\n".join(lines)
 
 
+def _numbers(n: int) -> str:
+    return "two numbers" if n == 2 else f"{n} numbers"
+
+
 def module_text(graph: ExportGraph) -> str:
     """The whole generated module."""
     width = max(len(label) for label, _ in graph.provenance)
     prov = "\n".join(f"    {label + ':':<{width + 1}} {value}" for label, value in graph.provenance)
     used = sorted({st.op for p in graph.programs for st in p.body if st.op is not None})
-    n_mem = graph.layout.n_memory
+    n_mem, n_obs = graph.layout.n_memory, graph.layout.n_obs
+    inputs = "two observations" if n_obs == 2 else f"{n_obs} observations"
+    actions = action_text(graph.layout.n_actions)
     memory = (
         "Memory off: each program zeroes its bank before it runs"
         if graph.no_memory
@@ -116,8 +122,8 @@ def module_text(graph: ExportGraph) -> str:
 {prov}
 
 Usage: call reset() at the start of every episode (it zeroes all memory banks), then
-act(obs) once per step with the two observations; it returns (a_d, a_c): the discrete
-action (0, 1 or 2) and the continuous output (m[0] of the winning program's memory bank).
+act(obs) once per step with the {inputs}; it returns (a_d, a_c): the discrete
+action ({actions}) and the continuous output (m[0] of the winning program's memory bank).
 {memory}.
 Needs only the standard library; the results equal the mtpg engine's bit for bit (IEEE
 doubles, same C library math functions).
@@ -143,8 +149,8 @@ import math''',
     parts.append(f"_TEAMS = ({', '.join(f'_t{t}' for t in range(len(graph.teams)))},)")
     parts.append(
         "def act(obs):\n"
-        '    """One decision for observation obs (two numbers): returns (a_d, a_c)."""\n'
-        "    s = (float(obs[0]), float(obs[1]))\n"
+        f'    """One decision for observation obs ({_numbers(n_obs)}): returns (a_d, a_c)."""\n'
+        f"    s = ({', '.join(f'float(obs[{i}])' for i in range(n_obs))}{',' * (n_obs == 1)})\n"
         f"    visited = [False] * {len(graph.teams)}\n"
         "    del last_teams[:]\n"
         "    team = 0\n"

@@ -18,6 +18,7 @@ import csv
 import hashlib
 import io
 import os
+import re
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from typing import Any
 
 from mtpg._faults import point
 from mtpg.envs.specs.contract import TASK_NAMES
+from mtpg.envs.specs.gym_task import is_gym
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
 from mtpg.io.checkpoint import CHECKPOINT_DIR
 from mtpg.io.lock import LOCK_FILE
@@ -453,6 +455,15 @@ def _digest(text: str, n: int) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:n]
 
 
+def _file_safe(task: str) -> str:
+    """A task name as a file name may hold it.
+
+    A ``gym:`` name's colons, slashes and quotes become ``_`` (the file's ``tasks`` entry
+    keeps the name itself).
+    """
+    return re.sub(r"[^A-Za-z0-9._\-\[\]=;()+,]", "_", task) if is_gym(task) else task
+
+
 def champion_filename(task_names: tuple[str, ...]) -> str:
     """File name of the champion of a task subset: tasks in canonical order joined by "+".
 
@@ -462,7 +473,7 @@ def champion_filename(task_names: tuple[str, ...]) -> str:
     subset as ``6-tasks-HASH.json``; the file's ``tasks`` entry names the subset in full
     (:func:`read_champions` reads it back).
     """
-    tasks = canonical_tasks(task_names)
+    tasks = tuple(_file_safe(t) for t in canonical_tasks(task_names))
     full = "+".join(tasks) + ".json"
     if len(full.encode()) <= MAX_FILENAME:
         return full

@@ -22,12 +22,10 @@ from typing import Any
 
 import numpy as np
 
-from mtpg.envs.specs.contract import N_OBS
 from mtpg.io._atomic import atomic_write_bytes
 from mtpg.io._bounded import MAX_GRAPH_BYTES, TooLargeError, check_depth, limit, read_file_bounded
 from mtpg.io._readable import Encoded, dumps_readable, encode_at
 from mtpg.model.graph import (
-    N_ACTIONS,
     InvariantError,
     Population,
     Program,
@@ -50,6 +48,8 @@ GRAPH_VERSION = 1
 _LAYOUT_KEYS = ("n_registers", "n_memory", "n_obs")
 #: Largest register-bank size a file may declare (``program.n_registers`` / ``n_memory``).
 MAX_BANK_SIZE = 256
+#: Largest number of observed inputs or atomic actions a file may declare.
+MAX_INPUTS = 1 << 16
 #: Integers in files must fit a signed 64-bit integer (ids become int64 arrays).
 _INT64 = (-(2**63), 2**63 - 1)
 
@@ -103,13 +103,14 @@ def _check_tag(d: dict[str, Any], fmt: str, versions: tuple[int, ...], what: str
 def _layout_from(value: Any) -> RegisterLayout:
     obj = _object(value, "layout")
     sizes = {k: _int(_key(obj, k, "layout"), f"layout.{k}", lo=1) for k in _LAYOUT_KEYS}
-    extra = sorted(set(obj) - set(_LAYOUT_KEYS))
+    if "n_actions" in obj:  # written only when not the paper's 3 (older files: 3)
+        sizes["n_actions"] = _int(obj["n_actions"], "layout.n_actions", lo=1)
+    extra = sorted(set(obj) - {*_LAYOUT_KEYS, "n_actions"})
     if extra:
         raise FormatError(f"layout has unknown keys {extra}")
-    if sizes["n_obs"] != N_OBS:  # every task observes two values (mtpg.envs.specs.contract.N_OBS)
-        raise FormatError(
-            f"layout.n_obs must be {N_OBS} (the tasks' interface), got {sizes['n_obs']}"
-        )
+    for key, top in (("n_obs", MAX_INPUTS), ("n_actions", MAX_INPUTS)):
+        if sizes.get(key, 0) > top:
+            raise FormatError(f"layout.{key} must be <= {top}, got {sizes[key]}")
     for key in ("n_registers", "n_memory"):
         if sizes[key] > MAX_BANK_SIZE:
             raise FormatError(f"layout.{key} must be <= {MAX_BANK_SIZE}, got {sizes[key]}")
@@ -142,7 +143,10 @@ def _check_population(pop: Population, what: str) -> None:
 
 
 def _layout_dict(layout: RegisterLayout) -> dict[str, int]:
-    return {k: int(getattr(layout, k)) for k in _LAYOUT_KEYS}
+    out = {k: int(getattr(layout, k)) for k in _LAYOUT_KEYS}
+    if layout.n_actions != 3:  # the paper's files stay as they were
+        out["n_actions"] = int(layout.n_actions)
+    return out
 
 
 def _code(instructions: np.ndarray) -> list[list[int]]:
@@ -217,7 +221,7 @@ def population_from_dict(d: Any) -> Population:
         if pid in pop.programs:
             raise FormatError(f"{where} appears twice")
         code = _instructions_from(_key(obj, "instructions", where), where, pop.layout)
-        action = _int(_key(obj, "action", where), f"{where} action", lo=-N_ACTIONS)
+        action = _int(_key(obj, "action", where), f"{where} action", lo=-pop.layout.n_actions)
         bank = _int(_key(obj, "bank", where), f"{where} bank", lo=0)
         pop.programs[pid] = Program(pid, code, action, bank)
     for i, item in enumerate(_list(_key(d, "teams", "population"), "population.teams")):
@@ -306,14 +310,14 @@ def _program_dict(pop: Population, pid: int) -> dict:
     }
 
 
-def _action_from(value: Any, where: str) -> int:
+def _action_from(value: Any, where: str, n_actions: int) -> int:
     obj = _object(value, f"{where} action")
     if len(obj) != 1 or next(iter(obj)) not in ("atomic", "team"):
         raise FormatError(f'{where} action must be {{"atomic": a}} or {{"team": id}}, got {obj}')
     if "atomic" in obj:
         a = _int(obj["atomic"], f"{where} atomic action", lo=0)
-        if a >= N_ACTIONS:
-            raise FormatError(f"{where} atomic action must be < {N_ACTIONS}, got {a}")
+        if a >= n_actions:
+            raise FormatError(f"{where} atomic action must be < {n_actions}, got {a}")
         return atomic(a)
     return _int(obj["team"], f"{where} team pointer", lo=0)
 
@@ -349,7 +353,7 @@ def graph_from_dict(d: Any) -> tuple[Population, int]:
         if pid in pop.programs:
             raise FormatError(f"{where} appears twice")
         code = _instructions_from(_key(obj, "instructions", where), where, pop.layout)
-        action = _action_from(_key(obj, "action", where), where)
+        action = _action_from(_key(obj, "action", where), where, pop.layout.n_actions)
         bank = _int(_key(obj, "bank", where), f"{where} bank", lo=0)
         pop.programs[pid] = Program(pid, code, action, bank)
     for i, item in enumerate(_list(d["teams"], "graph teams")):

@@ -236,7 +236,8 @@ def check_invariants(pop: Population) -> None:
         problem = valid_instructions(prog.instructions, pop.layout)
         _require(problem is None, f"program {pid}: {problem}")
         if prog.is_atomic:
-            _require(prog.atomic_action < N_ACTIONS, f"program {pid} action {prog.action}")
+            n_act = pop.layout.n_actions
+            _require(prog.atomic_action < n_act, f"program {pid} action {prog.action}")
         else:
             _require(prog.action in pop.teams, f"program {pid} points to missing team")
         _require(prog.bank in pop.memory_banks, f"program {pid} points to missing bank {prog.bank}")

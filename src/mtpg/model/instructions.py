@@ -119,17 +119,24 @@ LOG_TINY = -700.0
 
 @dataclass(frozen=True, slots=True)
 class RegisterLayout:
-    """Sizes of the register file one program execution sees."""
+    """Sizes of what a program sees and emits: its register file, inputs and actions.
+
+    The inputs and the atomic actions are the run's tasks' (the paper's six: 2 and 3; the
+    largest over the tasks of a run, :attr:`mtpg.envs.taskset.task_table.TaskTable.shape`).
+    """
 
     n_registers: int = 8
     """Private stateless registers ``r``; ``r[0]`` is the program's bid."""
     n_memory: int = 8
-    """Registers of a shared stateful memory bank ``m``; ``m[0]`` is the continuous output."""
+    """Registers of a shared stateful memory bank ``m``; ``m[0]`` is the continuous output
+    (``m[j]`` the continuous action's dimension ``j``)."""
     n_obs: int = 2
     """Observed inputs ``s(t)``."""
+    n_actions: int = 3
+    """Atomic actions a program may hold (``0 .. n_actions - 1``)."""
 
     def __post_init__(self) -> None:
-        for name in ("n_registers", "n_memory", "n_obs"):
+        for name in ("n_registers", "n_memory", "n_obs", "n_actions"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
 

@@ -110,6 +110,13 @@ def build_report(run_dirs: list[str | Path], out: str | Path | None = None) -> P
     for text in mixed:
         warnings.warn(text, MixedRunsWarning, stacklevel=2)
     numbers = {r.path: run_numbers(r) for r in runs}
+    raw = sorted({t for n in numbers.values() for t, v in n.normalised.items() if v != v})
+    if raw:  # a Gymnasium task without a reference best: its scores are raw
+        raise ValueError(
+            f"{', '.join(raw)}: no reference best, so the report's normalised figures cannot "
+            'be drawn; give one, evaluation.references = ["TASK: best=NUMBER, source=TEXT"] '
+            "(mtpg evaluate prints the raw scores)"
+        )
     estimates = {g.label: statistics_figures.group_estimates(g, numbers) for g in groups}
     pairs = statistics_figures.improvements(groups, numbers)
     out = Path(out) if out is not None else runs[0].path / "report"

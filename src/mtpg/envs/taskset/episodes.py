@@ -89,14 +89,18 @@ def draw_episodes(
         raise ValueError(f"tasks and seeds differ in length: {tasks.shape} vs {seeds.shape}")
     n = tasks.shape[0]
     specs = {int(t): table.spec(int(t)) for t in set(tasks.tolist())}
-    limits = {t: spec.max_steps for t, spec in specs.items()}
-    width = max(limits.values()) + 1 if n else 1
-    noisy = {t for t, spec in specs.items() if obs_noise_sd(spec) > 0.0}
+    # a Gymnasium task's episodes come from its reset(seed=...): its rows stay zero
+    gym = {t for t in specs if table.is_gym(t)}
+    limits = {t: spec.max_steps for t, spec in specs.items() if t not in gym}
+    width = max(limits.values()) + 1 if limits else 1
+    noisy = {t for t, spec in specs.items() if t not in gym and obs_noise_sd(spec) > 0.0}
     starts = np.zeros((n, STATE_SIZE), dtype=np.float64)
     noise = np.zeros((n, width), dtype=np.float64)
     obs_noise = np.zeros((n, width if noisy else 0, 2), dtype=np.float64)
     for i in range(n):
         task = int(tasks[i])
+        if task in gym:
+            continue
         rng = np.random.default_rng(int(seeds[i]))
         starts[i] = sample_start(task, rng, table)
         k = limits[task] + 1

@@ -30,6 +30,8 @@ import numpy as np
 
 from mtpg.envs.dynamics.rollout import run_episodes, run_time_optimal
 from mtpg.envs.specs.contract import CARTCENTERING
+from mtpg.envs.specs.gym_task import GymTask
+from mtpg.envs.specs.gym_task import measure_random as measure_gym_random
 from mtpg.envs.specs.param_table import TASK_PARAMS
 from mtpg.envs.specs.registry import TASKS
 from mtpg.envs.specs.task_spec import NONE, Reference
@@ -40,7 +42,7 @@ from mtpg.envs.taskset.episode_seeds import (  # noqa: F401  (the seed bases liv
     held_out_seeds,
 )
 from mtpg.envs.taskset.episodes import make_episodes
-from mtpg.envs.taskset.task_table import REGISTERED, TaskTable
+from mtpg.envs.taskset.task_table import REGISTERED, GivenReference, TaskTable
 
 #: Seed of the random agent's action generator.
 RANDOM_ACTION_SEED = 12345
@@ -145,6 +147,8 @@ def reference_of(task: int | str, table: TaskTable = REGISTERED) -> Reference:
         table: The task table (the registered tasks by default).
     """
     spec = table.spec(task)
+    if isinstance(spec, GymTask):
+        return gym_reference(spec, table.given_reference(spec.name))
     if not spec.base:
         return spec.reference
     given = table.given_reference(spec.name)
@@ -157,6 +161,20 @@ def reference_of(task: int | str, table: TaskTable = REGISTERED) -> Reference:
         return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")
     base = table.spec(spec.base).reference
     return Reference(*random, base.best, base.solved, f"{how}; best of {spec.base}: {base.source}")
+
+
+def gym_reference(task: GymTask, given: GivenReference | None) -> Reference:
+    """A Gymnasium task's reference scores: random play measured (or given), best given.
+
+    Without a given best, ``best`` is NaN: its scores are reported raw, not normalised.
+    """
+    if given is not None and given.random is not None:
+        random, how = (given.random, NONE), "random given"
+    else:
+        random, how = measure_gym_random(task.name), "random measured"
+    if given is None:
+        return Reference(*random, NONE, NONE, f"{how}; no best given: scores are raw")
+    return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")
 
 
 def normalise(

@@ -24,6 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mtpg.envs.specs.gym_task import GymTask, is_gym
 from mtpg.envs.specs.param_table import TASK_PARAMS, param_row, params_table
 from mtpg.envs.specs.registry import TASK_NAMES, TASKS
 from mtpg.envs.specs.task_spec import TaskSpec
@@ -31,6 +32,12 @@ from mtpg.envs.taskset.variants import canonical, is_variant, variant_row, varia
 
 #: The first variant id of a table (registered tasks keep 0..).
 VARIANT_ID_BASE = 256
+#: The first Gymnasium task id of a table (:mod:`mtpg.envs.specs.gym_task`): tasks that step in
+#: Python, never in the compiled kernels.
+GYM_ID_BASE = 1 << 20
+#: The interface of the registered tasks: two observed inputs, three atomic actions and
+#: one continuous output (``m[0]``).
+BUILTIN_SHAPE = (2, 3, 1)
 
 
 class GivenReference(NamedTuple):
@@ -64,10 +71,13 @@ def parse_given(text: str) -> GivenReference:
     Raises:
         ValueError: One line naming the fault.
     """
-    task, sep, rest = (s.strip() for s in text.partition(":"))
+    # a gym:ID task holds colons of its own: its entry is split at the first ": "
+    task, sep, rest = (s.strip() for s in text.partition(": " if ": " in text else ":"))
     if not sep or not task:
         raise ValueError(f"{text!r}: write TASK: best=NUMBER[, random=NUMBER], source=TEXT")
-    if not is_variant(task):
+    if is_gym(task):
+        pass  # a Gymnasium task's scores are given or raw
+    elif not is_variant(task):
         raise ValueError(f"{task}: a registered task's reference scores are the registry's")
     if canonical(task) != task:
         raise ValueError(f"{task}: spell it {canonical(task)!r}")
@@ -104,6 +114,7 @@ class TaskTable:
         variants: The table's variant specs; variant ``k`` has id ``VARIANT_ID_BASE + k``.
         params: float64 ``[ids, N_PARAMS]`` read-only parameter table the kernels index.
         given: Reference scores given for variants of the table, one per variant at most.
+        gym: The table's Gymnasium tasks; task ``k`` has id ``GYM_ID_BASE + k``.
     """
 
     names: tuple[str, ...]
@@ -111,6 +122,7 @@ class TaskTable:
     variants: tuple[TaskSpec, ...]
     params: np.ndarray
     given: tuple[GivenReference, ...] = ()
+    gym: tuple[GymTask, ...] = ()
 
     @classmethod
     def from_names(
@@ -129,15 +141,19 @@ class TaskTable:
         """
         names = tuple(canonical(n) for n in names)
         variants: list[TaskSpec] = []
+        gym: list[GymTask] = []
         for name in dict.fromkeys(names):
-            if is_variant(name):
+            if is_gym(name):
+                gym.append(GymTask.from_name(name))
+            elif is_variant(name):
                 variants.append(variant_spec(name))
         var_ids = {v.name: VARIANT_ID_BASE + k for k, v in enumerate(variants)}
+        var_ids.update({t.name: GYM_ID_BASE + k for k, t in enumerate(gym)})
         ids = tuple(var_ids[n] if n in var_ids else TASK_NAMES.index(n) for n in names)
         given: dict[str, GivenReference] = {}
         for entry in references:
             ref = parse_given(entry) if isinstance(entry, str) else entry
-            if ref.task not in var_ids:
+            if ref.task not in var_ids:  # variants and Gymnasium tasks
                 raise ValueError(f"{ref.task}: reference scores given for a task not in the run")
             if ref.task in given:
                 raise ValueError(f"{ref.task}: reference scores given twice")
@@ -147,7 +163,14 @@ class TaskTable:
             padding = [param_row((1.0, 0.0), -1)] * (VARIANT_ID_BASE - len(TASK_PARAMS))
             rows = [*TASK_PARAMS, *padding, *(variant_row(v) for v in variants)]
             params = params_table(rows)
-        return cls(names, ids, tuple(variants), params, tuple(given.values()))
+        compiled = [n for n in names if not is_gym(n)]
+        many = [t.name for t in gym if t.n_actions > BUILTIN_SHAPE[1]]
+        if compiled and many:
+            raise ValueError(
+                f"{many[0]} takes more than {BUILTIN_SHAPE[1]} discrete actions, which the "
+                f"registered tasks ({compiled[0]}) cannot play; train it without them"
+            )
+        return cls(names, ids, tuple(variants), params, tuple(given.values()), tuple(gym))
 
     def id_of(self, name: str) -> int:
         """The id of a registered task, or of a variant of this table (any spelling).
@@ -161,10 +184,13 @@ class TaskTable:
         for k, spec in enumerate(self.variants):
             if spec.name == key:
                 return VARIANT_ID_BASE + k
+        for k, task in enumerate(self.gym):
+            if task.name == key:
+                return GYM_ID_BASE + k
         raise ValueError(f"task {key!r} is not in this task table ({', '.join(self.names)})")
 
-    def spec(self, task: int | str) -> TaskSpec:
-        """The spec of a task id or name of this table.
+    def spec(self, task: int | str) -> TaskSpec | GymTask:
+        """The spec of a task id or name of this table (a Gymnasium task's :class:`GymTask`).
 
         Raises:
             ValueError: For an id or name the table does not know.
@@ -172,22 +198,49 @@ class TaskTable:
         i = self.id_of(task) if isinstance(task, str) else int(task)
         if not self.valid_id(i):
             raise ValueError(f"unknown task id {i}; valid ids are {self.id_ranges()}")
+        if i >= GYM_ID_BASE:
+            return self.gym[i - GYM_ID_BASE]
         return TASKS[i] if i < len(TASKS) else self.variants[i - VARIANT_ID_BASE]
 
     @property
-    def specs(self) -> tuple[TaskSpec, ...]:
+    def specs(self) -> tuple[TaskSpec | GymTask, ...]:
         """The specs of the run's tasks, in ``names`` order."""
         return tuple(self.spec(i) for i in self.ids)
 
     def valid_id(self, task: int) -> bool:
-        """Whether an id names a registered task or a variant of this table."""
-        return 0 <= task < len(TASKS) or 0 <= task - VARIANT_ID_BASE < len(self.variants)
+        """Whether an id names a registered task, a variant or a Gymnasium task of this table."""
+        return (
+            0 <= task < len(TASKS)
+            or 0 <= task - VARIANT_ID_BASE < len(self.variants)
+            or 0 <= task - GYM_ID_BASE < len(self.gym)
+        )
+
+    def is_gym(self, task: int) -> bool:
+        """Whether a task id of this table is a Gymnasium task (it steps in Python)."""
+        return task >= GYM_ID_BASE
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """The run's interface: observed inputs, atomic actions, continuous outputs.
+
+        The largest over the run's tasks (the registered tasks: 2, 3 and 1). A task with
+        fewer inputs leaves the rest at 0; one with fewer discrete actions folds atomic
+        action ``a`` onto ``a mod n`` (:mod:`mtpg.envs.specs.gym_task`).
+        """
+        shapes = [
+            (t.n_obs, t.n_actions, t.n_continuous) if self.is_gym(i) else BUILTIN_SHAPE
+            for i, t in zip(self.ids, self.specs, strict=True)
+        ]
+        n_obs, n_act, n_cont = (max(column) for column in zip(*shapes, strict=True))
+        return n_obs, max(n_act, 1), n_cont
 
     def id_ranges(self) -> str:
         """The valid ids, as text (``0..5`` or ``0..5, 256..257``)."""
         text = f"0..{len(TASKS) - 1}"
         if self.variants:
             text += f", {VARIANT_ID_BASE}..{VARIANT_ID_BASE + len(self.variants) - 1}"
+        if self.gym:
+            text += f", {GYM_ID_BASE}..{GYM_ID_BASE + len(self.gym) - 1}"
         return text
 
     def given_reference(self, name: str) -> GivenReference | None:

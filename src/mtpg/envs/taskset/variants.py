@@ -44,6 +44,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from mtpg.envs.specs.gym_task import canonical as gym_canonical
+from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.specs.param_table import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP, param_row
 from mtpg.envs.specs.registry import TASK_NAMES, TASKS
 from mtpg.envs.specs.task_spec import NONE, Reference, TaskSpec, variant_gym_id
@@ -52,8 +54,8 @@ _NAME = re.compile(r"^(?P<base>[A-Za-z][A-Za-z0-9]*)\[(?P<body>[^\[\]]*)\]$")
 
 
 def is_variant(name: str) -> bool:
-    """Whether a task name is written as a variant (``Base[...]``)."""
-    return "[" in name
+    """Whether a task name is written as a variant (``Base[...]``; not a ``gym:`` task)."""
+    return "[" in name and not is_gym(name)
 
 
 def _fail(text: str, message: str) -> ValueError:
@@ -193,9 +195,14 @@ def canonical(text: str) -> str:
     Raises:
         ValueError: For an unknown task or a bad variant (see :func:`parse`).
     """
+    if is_gym(text):
+        return gym_canonical(text)
     if not is_variant(text):
         if text not in TASK_NAMES:
-            raise ValueError(f"unknown task {text!r}; choose from {', '.join(TASK_NAMES)}")
+            raise ValueError(
+                f"unknown task {text!r}; choose from {', '.join(TASK_NAMES)} "
+                "or a Gymnasium environment, gym:ID"
+            )
         return text
     base, settings = parse(text)
     return f"{base.name}[{';'.join(f'{k}={settings[k]}' for k in sorted(settings))}]"
@@ -252,6 +259,8 @@ def from_tables(tables: object) -> list[str]:
 
 def order_key(name: str) -> tuple[int, int, str]:
     """Sorts task names by registry id, each variant after its base, variants by name."""
+    if is_gym(name):  # after every registered task and variant, by name
+        return (len(TASK_NAMES), 0, name)
     base = name.split("[", 1)[0]
     return (TASK_NAMES.index(base), int(is_variant(name)), name)
 

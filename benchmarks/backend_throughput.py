@@ -97,4 +97,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    from mtpg._kernel_cache import refresh
+
+    refresh()  # before the first kernel: a Numba cache older than the sources goes
     main()

@@ -20,6 +20,17 @@ PROFILE = os.environ.get("HYPOTHESIS_PROFILE", "ci")
 settings.load_profile(PROFILE)
 
 
+def pytest_sessionstart(session) -> None:
+    """Clears Numba's kernel cache if the sources changed, before any test runs a kernel.
+
+    ``import mtpg`` no longer does it (importing changes no file); the tests run kernels
+    in this process, so the suite does it as the command line does.
+    """
+    from mtpg._kernel_cache import refresh
+
+    refresh()
+
+
 def pytest_report_header(config) -> str:
     current = settings.get_current_profile_name()
     mode = "fixed examples (derandomize)" if settings().derandomize else "random examples"

@@ -42,4 +42,19 @@ def test_the_fingerprint_covers_paths_and_bytes(tmp_path: Path) -> None:
 def test_the_installed_package_is_stamped_with_its_sources() -> None:
     import mtpg._kernel_cache as guard
 
+    refresh()  # as the command line and the suite's start do
     assert guard._STAMP.read_text() == fingerprint()
+
+
+def test_the_command_line_refreshes_before_its_command_runs(monkeypatch, capsys) -> None:
+    import mtpg._kernel_cache as guard
+    from mtpg.cli.main import main
+
+    def refresh() -> bool:
+        raise RuntimeError("refreshed")
+
+    monkeypatch.setattr(guard, "refresh", refresh)
+    assert main([]) == 2  # no command (the help): nothing to refresh for
+    assert "refreshed" not in capsys.readouterr().err
+    assert main(["show", "no-such-graph.json"]) == 1  # the refresh came before the command
+    assert "internal error: RuntimeError: refreshed" in capsys.readouterr().err

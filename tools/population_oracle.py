@@ -77,4 +77,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    from mtpg._kernel_cache import refresh
+
+    refresh()  # before the first kernel: a Numba cache older than the sources goes
     sys.exit(main())

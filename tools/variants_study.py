@@ -177,4 +177,7 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    from mtpg._kernel_cache import refresh
+
+    refresh()  # before the first kernel: a Numba cache older than the sources goes
     raise SystemExit(main())

@@ -2,8 +2,6 @@
 
 __version__ = "0.1.0"
 
-from mtpg._kernel_cache import refresh as _refresh_kernel_cache
-
-_refresh_kernel_cache()  # before any kernel loads: a cache older than the sources goes
-
-import mtpg.envs  # noqa: E402, F401  (registers the Gymnasium ids mtpg/<Task>-v0; numba loads lazily)
+# Importing changes no file: the kernel cache is checked by the programs that run kernels
+# (mtpg._kernel_cache.refresh, called by the command line before every command).
+import mtpg.envs  # noqa: F401  (registers the Gymnasium ids mtpg/<Task>-v0; numba loads lazily)

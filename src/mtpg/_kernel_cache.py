@@ -8,18 +8,28 @@ episode loop would still observe the old way: results would silently differ from
 sources (this happened once while the variant keys were added).
 
 So the package keeps a fingerprint of all its sources (their bytes, hashed) beside its
-cache. At import, if the sources differ from the fingerprint, every cached kernel of the
-package is deleted before any is loaded, and Numba compiles afresh. Hashing the ~150
+cache. :func:`refresh` compares them: if the sources differ from the fingerprint, every
+cached kernel of the package is deleted, and Numba compiles afresh. Hashing the ~150
 source files takes a few milliseconds. An installed package whose folders cannot be
 written is left alone: Numba then caches in a user folder, and an upgrade rewrites
 every source file, which Numba does notice.
+
+``import mtpg`` does not call it (importing changes no file). It must run before the
+first kernel of a process is called (Numba loads a cached kernel at its first call), so
+the programs that run kernels call it first: the command line (``mtpg``, at the start of
+every command), the test suite (``tests/conftest.py``) and the scripts of ``tools/`` and
+``benchmarks/`` that run kernels in their own process. Python code that edits the sources
+of a checkout and then runs kernels in-process calls ``mtpg._kernel_cache.refresh()``.
 """
 
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
 from pathlib import Path
+
+_LOG = logging.getLogger(__name__)
 
 _ROOT = Path(__file__).resolve().parent
 _STAMP = _ROOT / "__pycache__" / "kernel-sources.sha256"
@@ -56,11 +66,13 @@ def refresh(root: Path = _ROOT, stamp: Path = _STAMP) -> bool:
         pass
     if not os.access(root, os.W_OK):
         return False
-    for path in cached_kernels(root):
+    stale = cached_kernels(root)
+    for path in stale:
         try:
             path.unlink()
         except OSError:  # another process cleared it first
             pass
+    _LOG.debug("kernel cache: the sources changed; %d cached kernel files removed", len(stale))
     try:
         stamp.parent.mkdir(exist_ok=True)
         tmp = stamp.with_suffix(f".{os.getpid()}")

@@ -124,6 +124,10 @@ def _silence_stdout() -> None:
 def main(argv: list[str] | None = None) -> int:
     """Runs the command line.
 
+    Before the command runs, Numba's kernel cache is cleared if the package's sources
+    changed since it was compiled (:func:`mtpg._kernel_cache.refresh`); ``--debug`` sets
+    ``MTPG_DEBUG`` for the libraries' own logs and child processes while it runs.
+
     Args:
         argv: Arguments without the program name; ``sys.argv[1:]`` when None.
 
@@ -140,6 +144,9 @@ def main(argv: list[str] | None = None) -> int:
     if set_here:  # libraries' own logs too (Dask's, see DaskEvaluator), and child processes
         os.environ["MTPG_DEBUG"] = "1"
     try:
+        from mtpg._kernel_cache import refresh
+
+        refresh()  # before any kernel loads: a cache older than the sources goes
         code = int(args.func(args) or 0)
         sys.stdout.flush()  # a closed pipe shows here, not at exit
         return code

@@ -43,7 +43,7 @@ def _reset(task: GymTask, env, seed: int) -> np.ndarray:
         raise GymTaskError(
             f"task {task.name}: episode seed {seed}: reset raised {type(exc).__name__}: {what}"
         ) from None
-    return task.scale(obs, seed)
+    return task.flat(obs, seed)
 
 
 def play_gym(
@@ -82,14 +82,16 @@ def _play_chunk(cp, roots, task, seeds):
     live = LiveDecider(cp, roots, n_continuous=task.n_continuous)
     envs = [task.make() for _ in range(n)]
     try:
-        obs = np.zeros((n, task.n_obs))
+        raw = np.zeros((n, task.n_obs))
         for j in range(n):
-            obs[j] = _reset(task, envs[j], int(seeds[j]))
+            raw[j] = _reset(task, envs[j], int(seeds[j]))
         returns = [0.0] * n
         steps = np.zeros(n, dtype=np.int64)
         alive = np.arange(n, dtype=np.int64)
         while len(alive):
-            a_d, a_c = live.decide(alive, obs[alive])
+            # every live observation scaled (and checked) at once, then one decision call
+            obs = task.scale_rows(raw[alive], seeds[alive])
+            a_d, a_c = live.decide(alive, obs)
             still = []
             for k, j in enumerate(alive.tolist()):
                 seed = int(seeds[j])
@@ -99,7 +101,7 @@ def _play_chunk(cp, roots, task, seeds):
                 returns[j] += float(reward)
                 steps[j] += 1
                 if not (terminated or truncated):
-                    obs[j] = task.scale(o, seed)
+                    raw[j] = task.flat(o, seed)
                     still.append(j)
             alive = np.array(still, dtype=np.int64)
     finally:

@@ -209,11 +209,11 @@ class GymTask:
         """A new instance of the environment."""
         return _make(self.name, self.env_id, self.kwargs)
 
-    def scale(self, obs: Any, seed: int) -> np.ndarray:
-        """The observation in the programs' range (see the module docstring).
+    def flat(self, obs: Any, seed: int) -> np.ndarray:
+        """The raw observation as float64 ``[n_obs]``.
 
         Raises:
-            GymTaskError: For an observation that is not finite or outside its bounds.
+            GymTaskError: For an observation of another size than the space declares.
         """
         o = np.asarray(obs, dtype=np.float64).ravel()
         if o.shape != self.obs_low.shape:
@@ -221,13 +221,31 @@ class GymTask:
                 f"task {self.name}: episode seed {seed}: observation of {o.size} values, "
                 f"the space declares {self.n_obs}"
             )
-        if not np.isfinite(o).all():
-            bad = int(np.argmax(~np.isfinite(o)))
+        return o
+
+    def scale(self, obs: Any, seed: int) -> np.ndarray:
+        """The observation in the programs' range (see the module docstring).
+
+        Raises:
+            GymTaskError: For an observation that is not finite or outside its bounds.
+        """
+        o = self.flat(obs, seed)
+        return self.scale_rows(o.reshape(1, -1), np.array([seed]))[0]
+
+    def scale_rows(self, raw: np.ndarray, seeds: np.ndarray) -> np.ndarray:
+        """Scales many raw observations at once (rows of ``raw``, episode seeds ``seeds``).
+
+        Raises:
+            GymTaskError: For the first row that is not finite or outside its bounds.
+        """
+        finite = np.isfinite(raw)
+        if not finite.all():
+            row, col = np.argwhere(~finite)[0]
             raise GymTaskError(
-                f"task {self.name}: episode seed {seed}: observation[{bad}] = "
-                f"{float(o[bad])!r} is not finite"
+                f"task {self.name}: episode seed {int(seeds[row])}: observation[{col}] = "
+                f"{float(raw[row, col])!r} is not finite"
             )
-        return scale_obs(o, self.obs_low, self.obs_high, self.name, seed)
+        return scale_obs(raw, self.obs_low, self.obs_high, self.name, seeds)
 
     def action(self, a_d: int, a_c: np.ndarray) -> Any:
         """The environment action of an atomic action and the continuous outputs."""
@@ -279,17 +297,28 @@ def _make(name: str, env_id: str, kwargs: dict[str, Any]) -> Any:
         ) from None
 
 
-def scale_obs(o: np.ndarray, low: np.ndarray, high: np.ndarray, name: str, seed: int) -> np.ndarray:
-    """Scales finite-bounded inputs to [-1, 1], passes the others through ``tanh``."""
+def scale_obs(
+    o: np.ndarray, low: np.ndarray, high: np.ndarray, name: str, seed: int | np.ndarray
+) -> np.ndarray:
+    """Scales finite-bounded inputs to [-1, 1], passes the others through ``tanh``.
+
+    ``o`` is one observation or a matrix of them (one row per episode, ``seed`` then an
+    array of their seeds).
+
+    Raises:
+        GymTaskError: For the first input outside its finite bounds, naming its seed.
+    """
     finite = np.isfinite(low) & np.isfinite(high)
     span = np.where(finite, high - low, 1.0)
     tol = BOUND_TOL * (1.0 + np.abs(np.where(finite, span, 0.0)))
     outside = finite & ((o < low - tol) | (o > high + tol))
     if outside.any():
-        i = int(np.argmax(outside))
+        at = np.argwhere(outside)[0]
+        i = int(at[-1])
+        which = int(np.asarray(seed).reshape(-1)[at[0]] if o.ndim == 2 else seed)
         raise GymTaskError(
-            f"task {name}: episode seed {seed}: observation[{i}] = {float(o[i])!r} is outside "
-            f"its declared bounds [{float(low[i])!r}, {float(high[i])!r}]"
+            f"task {name}: episode seed {which}: observation[{i}] = {float(o[tuple(at)])!r} "
+            f"is outside its declared bounds [{float(low[i])!r}, {float(high[i])!r}]"
         )
     scaled = np.where(finite, 2.0 * (o - np.where(finite, low, 0.0)) / span - 1.0, np.tanh(o))
     return np.clip(scaled, -1.0, 1.0)

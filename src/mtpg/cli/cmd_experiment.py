@@ -90,8 +90,7 @@ def run(args: argparse.Namespace) -> int:
                 config.generations,
                 args.parallel,
                 workers,
-                log=lambda m: print(m, file=sys.stderr),
-                stop=stop,
+                stop=stop,  # the runs' progress: the mtpg logger, on stderr (cli.main)
             )
         finally:
             watch.stop()

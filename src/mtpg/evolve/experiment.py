@@ -7,10 +7,12 @@ interrupted experiment continues where it stopped.
 
 from __future__ import annotations
 
+import logging
 import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +20,8 @@ from mtpg.ablations import ABLATION_TABLE, FULL_ALGORITHM, ablation
 from mtpg.evolve.stopping import GracefulStop, StopNow
 from mtpg.io.checkpoint import list_checkpoints
 from mtpg.io.rundir import is_run_dir
+
+_LOG = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -81,10 +85,13 @@ def execute(
     generations: int,
     parallel: int = 1,
     workers: int = 1,
-    log=print,
+    log: Callable[[str], None] | None = None,
     stop: GracefulStop | None = None,
 ) -> list[PlannedRun]:
     """Runs every unfinished run, ``parallel`` processes at a time.
+
+    Each run's progress (done, starting, finished, stopped, failed) is one message to
+    ``log``, by default the ``mtpg.evolve.experiment`` logger at INFO level.
 
     When ``stop`` receives a signal, it is passed on to the running processes (which
     stop at a generation boundary), no further run starts, and the running ones are
@@ -94,6 +101,7 @@ def execute(
     Returns:
         The runs that failed (empty when all finished).
     """
+    log = log or _LOG.info
     todo = [r for r in runs if r.state(generations) != "done"]
     for r in runs:
         if r not in todo:

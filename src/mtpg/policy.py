@@ -51,8 +51,10 @@ class Policy:
     """
 
     def __init__(self, population, root: int, task: str, no_memory: bool = False) -> None:
+        from mtpg._kernel_cache import refresh
         from mtpg.envs.taskset.task_table import TaskTable
 
+        refresh()  # a kernel is about to run: the cache must match the sources
         table = TaskTable.from_names([task])
         self.task = table.names[0]
         spec = table.spec(table.ids[0])

@@ -169,9 +169,7 @@ def test_gymnasium_cartpole_evaluates_as_a_plain_gymnasium_loop_replays_it(tmp_p
     assert np.mean(returns) == scored["gym:CartPole-v1"]["mean"]
 
 
-def test_a_failing_environment_stops_the_run_in_one_line_and_loses_nothing(
-    tmp_path, user_module
-):
+def test_a_failing_environment_stops_the_run_in_one_line_and_loses_nothing(tmp_path, user_module):
     from mtpg.io.checkpoint import list_checkpoints
 
     train = [*SMALL, "--tasks", TASK, "--generations", "4"]

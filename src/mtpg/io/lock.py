@@ -1,22 +1,32 @@
 """An exclusive advisory lock on a run directory: one writing process at a time.
 
-``mtpg train`` (new or ``--resume``) and ``mtpg experiment`` hold ``DIR/.lock`` with
-``fcntl.flock`` for as long as they write into ``DIR``. The kernel releases the lock when
-the process ends, however it ends (SIGKILL included), so a stale lock cannot outlive its
-holder. The file holds the holder's process id and host name, which a refused process
-names. Readers (``evaluate``, ``report``) take no lock.
+``mtpg train`` (new or ``--resume``) and ``mtpg experiment`` hold ``DIR/.lock`` for as
+long as they write into ``DIR``. The lock is the operating system's, taken through
+:func:`filelock.lock_descriptor` (``flock`` on Linux and macOS, ``LockFileEx`` on
+Windows; the primitive of ``filelock.FileLock``) on a descriptor this module opens and
+keeps, so that taking the lock writes nothing and the holder can leave a note in the
+file. The operating system releases the lock when the process ends, however it ends
+(SIGKILL included), so a stale lock cannot outlive its holder. The file holds the
+holder's process id and host name, which a refused process names (on Windows the
+locked first byte cannot be read by another process, which then names "another
+process"). Readers (``evaluate``, ``report``) take no lock.
 """
 
 from __future__ import annotations
 
 import contextlib
-import fcntl
 import os
 import socket
 from pathlib import Path
 
+from filelock import lock_descriptor, unlock_descriptor
+
 #: Name of the lock file inside a locked directory.
 LOCK_FILE = ".lock"
+
+#: Flags of the lock file's descriptor: not inherited by child processes where the
+#: platform has the flag, binary where it has that one (Windows).
+_OPEN_FLAGS = os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0) | getattr(os, "O_BINARY", 0)
 
 
 class LockedError(RuntimeError):
@@ -40,7 +50,8 @@ class DirLock:
             return
         try:
             os.ftruncate(self._fd, 0)
-            os.pwrite(self._fd, f"{os.getpid()} {socket.gethostname()}\n".encode(), 0)
+            os.lseek(self._fd, 0, os.SEEK_SET)
+            os.write(self._fd, f"{os.getpid()} {socket.gethostname()}\n".encode())
         except OSError:
             pass  # the lock holds without the note
 
@@ -48,7 +59,7 @@ class DirLock:
         """Releases the lock (the file stays, for the next holder)."""
         if self._fd is not None:
             with contextlib.suppress(OSError):
-                fcntl.flock(self._fd, fcntl.LOCK_UN)
+                unlock_descriptor(self._fd)
             os.close(self._fd)
             self._fd = None
 
@@ -84,20 +95,21 @@ def lock_dir(directory: str | os.PathLike[str], what: str = "mtpg") -> DirLock:
 
     Raises:
         LockedError: When another process holds it, naming that process.
-        OSError: When the lock file cannot be created or opened.
+        OSError: When the lock file cannot be created or opened, or the file system
+            cannot lock it.
     """
     path = Path(directory) / LOCK_FILE
-    fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    fd = os.open(path, _OPEN_FLAGS, 0o644)
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
+        taken = lock_descriptor(fd, blocking=False)
+    except BaseException:
+        os.close(fd)
+        raise
+    if not taken:
         os.close(fd)
         who = holder(directory) or "another process"
         raise LockedError(
             f"{directory}: {what} is in use by {who} (a train, --resume or experiment); "
             "wait for it to finish or stop it first"
-        ) from None
-    except BaseException:
-        os.close(fd)
-        raise
+        )
     return DirLock(path, fd)

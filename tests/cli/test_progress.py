@@ -1,3 +1,4 @@
+import contextlib
 import io
 from types import SimpleNamespace
 
@@ -130,39 +131,77 @@ def test_a_live_line_fits_the_terminal_width(monkeypatch):
         progress = Progress(10, tasks, stream=live, live=True)
         progress.begin(0)
         progress(row)
-        lines = live.getvalue().split("\r\x1b[2K")[1:]
+        written = live.getvalue().split("tasks: ", 1)[1].split("\n", 1)[1]  # after the header
+        assert "\n" not in written  # one line, rewritten in place (tqdm's carriage returns)
+        lines = [text.rstrip() for text in written.split("\r") if text.strip()]
         assert len(lines) == 2
-        assert all(len(text) <= columns - 1 for text in lines)
+        assert all(len(text) <= columns - 1 for text in written.split("\r"))  # padding too
+        assert lines[0].startswith("gen 1/10: compiling")
         assert lines[-1].startswith("gen 3/10 |") and lines[-1].endswith("...")
+        progress.close()
+        assert live.getvalue().endswith("\n") and live.getvalue().count("\n") == 6
+        progress.close()  # twice is harmless
     logged = io.StringIO()
     progress = Progress(10, tasks, stream=logged, live=False)
     progress(row)
     assert "teams/dec 1.90" in logged.getvalue()  # a log keeps the whole line
+    assert "\r" not in logged.getvalue()  # and has no live line
 
 
-def test_as_a_reporter_it_takes_the_test_scores_from_the_generation(tmp_path):
-    """No tests.csv is read: the test point's rows come with the generation."""
+def test_log_messages_go_above_a_live_line(monkeypatch):
+    """A warning while the line is live gets a line of its own; the status line is redrawn."""
     import io
+    import logging
+    import sys
 
     from mtpg.cli.progress import Progress
-    from mtpg.evolve.trainer import Generation, Reporter
 
-    tasks = ("CartPole", "Acrobot")
-    row = {"generation": 4, "t_total": 1.0, "decisions_per_s": 1e6, "teams_per_decision": 1.5}
-    row.update({f"best_{t}": 1.0 for t in tasks})
-    tests = [
-        {"generation": 4, "subset": "CartPole", "test_CartPole": 50.0},
-        {
-            "generation": 4,
-            "subset": "CartPole+Acrobot",
-            "test_CartPole": 12.5,
-            "test_Acrobot": -99.0,
-        },
-    ]
-    out = io.StringIO()
-    progress = Progress(10, tasks, stream=out, live=False, tests_file=tmp_path / "absent.csv")
-    assert isinstance(progress, Reporter)
-    progress.generation(Generation(4, row, tests), None)
-    assert "test@4 CP 12.5 AB -99" in out.getvalue()
-    progress.generation(Generation(5, {**row, "generation": 5}, None), None)
-    assert out.getvalue().splitlines()[-1].count("test@4") == 1  # kept until the next point
+    live = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", live)  # the CLI's handler writes to standard error
+    handler = logging.StreamHandler(sys.stderr)
+    logger = logging.getLogger("mtpg")
+    logger.addHandler(handler)
+    progress = Progress(10, ("CartPole",), stream=live, live=True)
+    try:
+        progress.begin(0)
+        with progress.messages():
+            logger.warning("something to say")
+    finally:
+        logger.removeHandler(handler)
+        progress.close()
+    after = live.getvalue().split("tasks: CP = CartPole\n", 1)[1]
+    assert after.startswith("\rgen 1/10: compiling")
+    # the line is cleared, the message written on a line of its own, the line redrawn
+    assert "\rsomething to say\n\rgen 1/10: compiling" in after
+    assert after.endswith("\n") and after.count("\n") == 2
+    assert isinstance(Progress(1, ("CartPole",), live=False).messages(), contextlib.nullcontext)
+
+
+def test_the_live_line_shows_on_a_terminal_that_reports_no_size(monkeypatch):
+    """A bare pseudo-terminal reports 0 x 0: tqdm would hide the line below the screen."""
+    import os
+    import sys
+
+    import pytest
+
+    from mtpg.cli.progress import Progress
+
+    pty = pytest.importorskip("pty")
+    leader, follower = pty.openpty()
+    with open(follower, "w", encoding="utf-8", closefd=True) as terminal:
+        assert terminal.isatty()
+        monkeypatch.setattr(sys, "stderr", terminal)  # tqdm reads the size of standard error
+        monkeypatch.delenv("COLUMNS", raising=False)
+        progress = Progress(10, ("CartPole",), stream=terminal)
+        assert progress.live
+        progress.begin(0)
+        progress.close()
+    written = b""
+    os.set_blocking(leader, False)
+    try:
+        while chunk := os.read(leader, 65536):
+            written += chunk
+    except (BlockingIOError, OSError):
+        pass
+    os.close(leader)
+    assert b"gen 1/10: compiling" in written

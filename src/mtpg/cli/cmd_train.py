@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 
 from mtpg.ablations import ABLATION_TABLE
@@ -143,7 +144,9 @@ def _train(args: argparse.Namespace) -> int:
             # BackendLost once the last generation is committed)
             # the progress display is the last reporter: it shows what the others committed
             shown = [*extra, progress] if progress is not None else extra
-            finished = session.run_all(None, stop.requested, shown)
+            # log messages go above a live progress line, not into it
+            with progress.messages() if progress else contextlib.nullcontext():
+                finished = session.run_all(None, stop.requested, shown)
         except BackendLost as exc:
             lost, finished = exc, False
         except StopNow as exc:

@@ -10,17 +10,27 @@ compiles, then one status line per generation (rewritten in place on a terminal)
 best on each, and training uses only a few episodes): it is not what the run has learnt.
 ``test@G`` is the all-task champion's mean return on the held-out episodes at the last test
 point G: the number the report shows.
+
+On a terminal the status line is a `tqdm <https://tqdm.github.io>`_ line (a text-only
+``bar_format``): tqdm rewrites it in place, and :meth:`Progress.messages` routes the
+``mtpg`` logger's messages through ``tqdm.write`` so that a warning does not break it.
+Elsewhere (a log file, a pipe) there is no live line: each generation is one whole line.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import logging
 import shutil
 import sys
 import threading
 import time
 from pathlib import Path
 from typing import TextIO
+
+from tqdm import tqdm
+from tqdm.contrib.logging import logging_redirect_tqdm
 
 from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.specs.gym_task import short as gym_short
@@ -55,6 +65,16 @@ def short_names(tasks: tuple[str, ...] | list[str]) -> dict[str, str]:
         else:
             out[t] = base[t]
     return out
+
+
+class StatusLine(tqdm):
+    """A tqdm line that shows only its description: the status text, rewritten in place.
+
+    Updated by hand once per generation, so tqdm's monitor thread (which tunes the
+    refresh rate of fast loops) is not started.
+    """
+
+    monitor_interval = 0
 
 
 def _fmt_rate(x: float) -> str:
@@ -135,6 +155,7 @@ class Progress(Reporter):
         self._last = self._started
         self._durations: list[float] = []
         self._header_done = False
+        self._line: StatusLine | None = None
 
     @classmethod
     def for_session(cls, session, **kwargs) -> Progress:
@@ -192,20 +213,46 @@ class Progress(Reporter):
             f"gen {generation + 1}/{self.total}: compiling the engine's kernels (cached after "
             "the first run), then evaluating..."
         )
-        self.stream.write(("\r\x1b[2K" + self._fit(text)) if self.live else text + "\n")
-        self.stream.flush()
+        self._write(text)
         self._last = time.perf_counter()
 
-    def _fit(self, text: str) -> str:
-        """A live line cut to the terminal's width (read at each write: it may change).
-
-        Clearing the line clears only the row the cursor is on: a line longer than the
-        terminal would wrap, and each update would leave its first rows behind.
-        """
+    def _write(self, text: str) -> None:
+        """Shows ``text``: the live line on a terminal, a whole line elsewhere."""
+        if not self.live:
+            self.stream.write(text + "\n")
+            self.stream.flush()
+            return
+        # The terminal's width is read at each write (it may change). A line longer than
+        # the terminal would wrap, and each rewrite would leave its first rows behind.
         width = shutil.get_terminal_size((80, 24)).columns - 1  # no wrap at the last column
-        if len(text) <= width:
-            return text
-        return text[: max(width - 3, 0)] + "..."
+        if len(text) > width:
+            text = text[: max(width - 3, 0)] + "..."
+        if self._line is None:
+            self._line = StatusLine(
+                desc=text,
+                file=self.stream,
+                bar_format="{desc}",
+                ncols=width,
+                mininterval=0,
+                position=0,  # the one line: never below lines of other tqdm bars
+                # tqdm hides lines below the screen's height, which it reads from the
+                # terminal unless given: a terminal that reports no size (a bare pty)
+                # would hide this one, at the top, too
+                nrows=2,
+            )
+        else:
+            self._line.ncols = width
+            self._line.set_description_str(text, refresh=True)
+
+    def messages(self) -> contextlib.AbstractContextManager[object]:
+        """A context in which the ``mtpg`` logger's messages leave the live line intact.
+
+        On a terminal they are written above the line (``tqdm.write``); elsewhere
+        nothing changes.
+        """
+        if not self.live:
+            return contextlib.nullcontext()
+        return logging_redirect_tqdm([logging.getLogger("mtpg")], tqdm_class=StatusLine)
 
     def eta(self, generation: int) -> float:
         """Seconds left: mean duration of the recent generations times those remaining.
@@ -255,20 +302,15 @@ class Progress(Reporter):
         self._durations.append(now - self._last)
         self._last = now
         self._write_header()
-        text = self.line(row)
-        if self.live:
-            self.stream.write("\r\x1b[2K" + self._fit(text))
-            if row["generation"] >= self.total:
-                self.stream.write("\n")
-        else:
-            self.stream.write(text + "\n")
-        self.stream.flush()
+        self._write(self.line(row))
+        if row["generation"] >= self.total:
+            self.close()
 
     def close(self) -> None:
-        """Ends a live line so later output starts on a new line."""
-        if self.live:
-            self.stream.write("\n")
-            self.stream.flush()
+        """Ends a live line so later output starts on a new line (twice is harmless)."""
+        if self._line is not None:
+            self._line.close()
+            self._line = None
 
 
 def run_generation(run_dir: Path) -> int:

@@ -449,7 +449,7 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     HandMutant(
         "selection-raw-not-normalised",
         "src/mtpg/evolve/selection.py",
-        "    norm = normalise(scores)\n    out = []",
+        "    norm = min_max_over_roots(scores)\n    out = []",
         "    norm = scores\n    out = []",
         _SELECTION,
     ),

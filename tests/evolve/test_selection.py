@@ -1,6 +1,6 @@
 import numpy as np
 
-from mtpg.evolve.selection import normalise, select, task_subsets
+from mtpg.evolve.selection import min_max_over_roots, select, task_subsets
 
 
 def test_subsets_power_set_order():
@@ -9,9 +9,9 @@ def test_subsets_power_set_order():
     assert len(task_subsets(6)) == 63
 
 
-def test_normalise_min_max_and_ties():
+def test_min_max_over_roots_and_ties():
     scores = np.array([[0.0, 5.0], [10.0, 5.0], [5.0, 5.0]])
-    norm = normalise(scores)
+    norm = min_max_over_roots(scores)
     assert norm[:, 0].tolist() == [0.0, 1.0, 0.5]
     assert norm[:, 1].tolist() == [1.0, 1.0, 1.0]  # all tie: everyone 1
 

@@ -136,8 +136,8 @@ def test_min_elite_total_in_a_run_keeps_the_rounded_up_count() -> None:
     assert rows[-1]["roots"] == 12
 
 
-def test_normalise_shifts_by_the_minimum() -> None:
-    from mtpg.evolve.selection import normalise
+def test_min_max_over_roots_shifts_by_the_minimum() -> None:
+    from mtpg.evolve.selection import min_max_over_roots
 
-    out = normalise(np.array([[2.0, -3.0], [4.0, -1.0], [3.0, -2.0]]))
+    out = min_max_over_roots(np.array([[2.0, -3.0], [4.0, -1.0], [3.0, -2.0]]))
     assert out.tolist() == [[0.0, 0.0], [1.0, 1.0], [0.5, 0.5]]

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mtpg.evolve.selection import candidates, normalise, rankings, select, task_subsets
+from mtpg.evolve.selection import candidates, min_max_over_roots, rankings, select, task_subsets
 
 #: Normalised scores worked by hand: every column has its minimum 0 and maximum 1.
 NORM = np.array(
@@ -48,7 +48,7 @@ ELITES_2 = [[1, 3], [2, 4], [5], [], [], [], []]
 
 
 def test_the_normalised_table_is_the_raw_one_min_max_normalised() -> None:
-    assert np.allclose(normalise(RAW), NORM)
+    assert np.allclose(min_max_over_roots(RAW), NORM)
 
 
 def test_task_subsets_claim_single_tasks_first() -> None:
@@ -83,7 +83,7 @@ def test_population_normalisation_is_over_all_current_roots() -> None:
     ids = np.append(IDS, 6)
     raw = np.vstack([RAW, [0.0, -1000.0, 1.0]])
     _, champions = select(ids, raw, task_subsets(3), 1)
-    norm = normalise(raw)
+    norm = min_max_over_roots(raw)
     assert norm[0, 1] == pytest.approx(800 / 850)  # root 1: (-200 + 1000) / (-150 + 1000)
     # (0,1): root 1 min(1.0, 0.94) = 0.94; root 3 min(0.7, 0.98) = 0.7; root 6 0
     assert champions[3] == 1

@@ -16,8 +16,12 @@ def task_subsets(n_tasks: int) -> list[tuple[int, ...]]:
     return [s for k in range(1, n_tasks + 1) for s in combinations(range(n_tasks), k)]
 
 
-def normalise(scores: np.ndarray) -> np.ndarray:
-    """Min-max normalises each task's mean scores over the roots.
+def min_max_over_roots(scores: np.ndarray) -> np.ndarray:
+    """Min-max normalises each task's mean scores over the current roots.
+
+    Relative to the population (0: the worst root on the task, 1: the best), unlike
+    :func:`mtpg.envs.taskset.reference_scores.normalise`, which scales a score between a
+    task's fixed random and best reference scores.
 
     Args:
         scores: float64 ``[n_roots, n_tasks]`` mean training scores.
@@ -38,7 +42,7 @@ def rankings(
 ) -> list[np.ndarray]:
     """Every subset's ranking of the roots by its fitness, best first.
 
-    A subset's fitness of a root is its minimum normalised score (:func:`normalise`) over
+    A subset's fitness of a root is its minimum normalised score (:func:`min_max_over_roots`) over
     the subset's tasks (paper section 4.1); ties go to the younger root (higher id).
 
     Args:
@@ -49,7 +53,7 @@ def rankings(
     Returns:
         For each subset, int ``[n_roots]`` row indices into ``root_ids``, best first.
     """
-    norm = normalise(scores)
+    norm = min_max_over_roots(scores)
     out = []
     for subset in subsets:
         fitness = norm[:, list(subset)].min(axis=1)

@@ -193,12 +193,12 @@ def test_examples_import_only_what_is_public(doc):
     assert not imports, f"{_doc_id(doc)}: {imports}"
 
 
-def test_the_readme_quotes_the_committed_results_as_results_readme_has_them():
-    """The results paragraph's numbers are those `tools/results_readme.py` wrote."""
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+def test_the_results_summary_quotes_the_committed_results_as_results_readme_has_them():
+    """The paragraph's numbers (docs/results-summary.md) are those results_readme.py wrote."""
+    summary = (ROOT / "docs" / "results-summary.md").read_text(encoding="utf-8")
     results = (ROOT / "results" / "README.md").read_text(encoding="utf-8")
-    item = readme.split("- **The paper's experiment, in the repository**", 1)[1]
-    item = " ".join(item.split("\n- **", 1)[0].split())
+    item = summary.split("- **The paper's experiment, in the repository**", 1)[1]
+    item = " ".join(item.split("\n#", 1)[0].split())
     six = r"(-?\d\.\d\d)" + r" / (-?\d\.\d\d)" * 5
     rows = re.findall(six, item)
     assert len(rows) >= 4
@@ -208,9 +208,10 @@ def test_the_readme_quotes_the_committed_results_as_results_readme_has_them():
     assert f"IQM over TPG seeds and all tasks: {iqm}." in results
 
 
-def test_the_readme_answers_does_it_reproduce_the_paper_as_the_results_page_does():
+@pytest.mark.parametrize("doc", ["README.md", "docs/results-summary.md"])
+def test_the_readme_answers_does_it_reproduce_the_paper_as_the_results_page_does(doc):
     """The README's answer is the page's, word for word (``tools/robust_section.answer``)."""
-    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    readme = " ".join((ROOT / doc).read_text(encoding="utf-8").split())
     results = (ROOT / "results" / "README.md").read_text(encoding="utf-8")
     [answer] = [ln for ln in results.splitlines() if ln.startswith("**Does it reproduce")]
     assert f"- {answer} " in readme
@@ -237,16 +238,16 @@ def test_constants_the_documents_quote_are_the_code_s():
     from mtpg.model.instructions import CONSTANTS, OP_NAMES, RegisterLayout
 
     layout = RegisterLayout()
-    readme = _flat("README.md")
+    concepts = _flat("docs/concepts.md")
     assert (
         f"({len(OP_NAMES)} operations, {layout.n_registers} private registers, "
-        f"{len(CONSTANTS)} constants)" in readme
+        f"{len(CONSTANTS)} constants)" in concepts
     )
-    assert f"**Memory bank**: {layout.n_memory} registers" in readme
+    assert f"**Memory bank**: {layout.n_memory} registers" in concepts
     paper = build_config("paper")
-    assert paper.evaluation.n_subsets == 63 and "each of the 63 non-empty sets" in readme
+    assert paper.evaluation.n_subsets == 63 and "each of the 63 non-empty sets" in concepts
     new_roots = paper.evaluation.n_subsets * paper.elites_per_subset
-    assert f"{new_roots:,} new roots per generation" in readme
+    assert f"{new_roots:,} new roots per generation" in _flat("docs/first-run.md")
     report = _flat("docs/report.md")
     assert f"over {statistics.N_RESAMPLES:,} resamples" in report
     assert f"({statistics.N_RESAMPLES_PROFILE:,} resamples per threshold)" in report

@@ -144,3 +144,12 @@ def test_bad_targets_are_refused_in_one_line(tmp_path):
         mtpg.evaluate(tmp_path / "nowhere")
     with pytest.raises(ValueError, match="trained without a run directory"):
         mtpg.Run(tiny()).report()
+
+
+def test_load_reads_the_committed_generations_only(tmp_path):
+    run = mtpg.train(tiny(), out=tmp_path / "run")
+    metrics = run.path / "metrics.csv"
+    lines = metrics.read_text().splitlines()
+    metrics.write_text("\n".join([*lines, "4" + lines[-1][1:]]) + "\n")  # killed after gen 4
+    again = mtpg.load(run.path)
+    assert again.generation == 3 and again.metrics == run.metrics

@@ -1,21 +1,10 @@
-"""The public API: configure, train, load and evaluate runs (what ``import mtpg`` offers).
+"""The public API: train, resume, load and evaluate runs (what ``import mtpg`` offers).
 
-::
-
-    import mtpg
-
-    config = mtpg.preset("demo", tasks=["CartPole", "MountainCar"], generations=10)
-    run = mtpg.train(config, out="runs/cartpole-mc")   # a run directory, as `mtpg train`
-    print(mtpg.evaluate(run, episodes=100))           # the all-task champion, held out
-    policy = run.policy("CartPole")                    # acts in your own loop
-
-Every function is a thin layer over the modules the commands use
-(:mod:`mtpg.config`, :mod:`mtpg.evolve.session`, :mod:`mtpg.evolve.trainer`,
-:mod:`mtpg.evolve.heldout_test`), so a run trained here is the run ``mtpg train`` makes
-with the same settings: it resumes with ``mtpg train --resume`` and reports with
-``mtpg report``. Scores the run cannot give (a ratio whose denominator plays no better
-than random, a task without a reference best) are NaN in the numbers, "n/a" in text and
-``null`` in JSON.
+A thin layer over the modules the commands use (:mod:`mtpg.evolve.session`,
+:mod:`mtpg.evolve.trainer`, :mod:`mtpg.evolve.heldout_test`), so a run trained here is the
+run ``mtpg train`` makes with the same settings: it resumes with ``mtpg train --resume``
+and reports with ``mtpg report``. A score a run cannot give is NaN in the numbers, "n/a"
+in text and ``null`` in JSON. Examples: docs/api.md.
 """
 
 from __future__ import annotations
@@ -97,7 +86,7 @@ class Run:
 
     @property
     def generation(self) -> int:
-        """Generations completed (the last committed one for a run directory)."""
+        """Generations completed (for a run directory: committed, as a resume keeps them)."""
         return int(self.metrics[-1]["generation"]) if self.metrics else 0
 
     @property
@@ -380,22 +369,28 @@ def evaluate(
 def load(run_dir: PathLike) -> Run:
     """Reads a run directory: configuration, metrics and test results (writes nothing).
 
+    Only committed generations are read (those up to the last checkpoint: what a resume
+    keeps), so a run killed between two checkpoints reads as it will resume.
+
     Raises:
         RunDirError: The directory holds no run (the message says why).
         RunSchemaError: A run of a schema version this mtpg does not read.
         ConfigError: Its ``config.toml`` cannot be read.
     """
+    from mtpg.io.checkpoint import checkpoint_generation, latest_checkpoint
     from mtpg.io.runconfig import read_run_config
     from mtpg.io.rundir import TESTS_FILE, RunDir
 
     folder = RunDir(Path(run_dir))
     config = read_run_config(folder.path)
-    return Run(
-        config,
-        folder.path,
-        _read_csv(folder.metrics),
-        _read_csv(folder.path / TESTS_FILE, text=("subset",)),
-    )
+    last = latest_checkpoint(folder.path)
+    committed = (checkpoint_generation(last) or 0) if last is not None else 0
+
+    def kept(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+        return [r for r in rows if int(r["generation"]) <= committed]
+
+    metrics = kept(_read_csv(folder.metrics))
+    return Run(config, folder.path, metrics, kept(_read_csv(folder.path / TESTS_FILE, ("subset",))))
 
 
 def _read_csv(path: Path, text: tuple[str, ...] = ()) -> list[dict[str, Any]]:

@@ -3,7 +3,7 @@
 import numpy as np
 from hypothesis import strategies as st
 
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.model.graph import Population
 
 

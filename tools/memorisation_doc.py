@@ -4,7 +4,7 @@ One command, from the repository root with the project's environment::
 
     .venv/bin/python tools/memorisation_doc.py
 
-It runs the memorisation probe (``mtpg probe``, :mod:`mtpg.analysis.runs.memorisation`)
+It runs the memorisation probe (``mtpg probe``, :mod:`mtpg.analysis.runs.champion_probe`)
 with its defaults on the all-task champion of every run in ``results/runs/`` and on the
 single-task champions of the ``TPG`` seeds, and writes the tables between the markers
 ``<!-- probe:begin -->`` and ``<!-- probe:end -->`` of the page. It reads the runs and
@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from mtpg.analysis.runs.champion_probe import Probe, probe_target, probe_text
 from mtpg.analysis.runs.champions import champion_path, tested_run
-from mtpg.analysis.runs.memorisation import Probe, probe_target, probe_text
 from mtpg.evolve.memorisation import DEFAULT_REDRAWS
 
 ROOT = Path(__file__).resolve().parents[1]

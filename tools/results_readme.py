@@ -305,7 +305,7 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
     if robust:
         probes = {}
         if probe:
-            from mtpg.analysis.runs.memorisation import probe_target
+            from mtpg.analysis.runs.champion_probe import probe_target
 
             probes = {r.name: probe_target(r.path) for r in [*tpg.runs, *robust]}
         lines += robust_section(comparison, robust, probes, TARGET)

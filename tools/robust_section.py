@@ -257,7 +257,7 @@ def section(c: Comparison, robust, probes: dict, target: int) -> list[str]:
     Args:
         c: The comparison (:func:`compare`).
         robust: The TPG-robust runs, all of them.
-        probes: Run name -> :class:`~mtpg.analysis.runs.memorisation.Probe` of its final
+        probes: Run name -> :class:`~mtpg.analysis.runs.champion_probe.Probe` of its final
             all-task champion (empty: no probe table).
         target: The generations every run grows to.
     """

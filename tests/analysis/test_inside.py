@@ -125,7 +125,7 @@ def test_a_cycle_forming_pointer_never_visits_a_team_twice():
 
 
 def test_replayed_returns_equal_evaluate(tmp_path):
-    from mtpg.engine.workload import layered_graphs
+    from mtpg.engine.random_populations import layered_graphs
     from mtpg.evolve.heldout_test import evaluate_graph
 
     pop, roots = layered_graphs(np.random.default_rng(3), 2, teams=3, programs=4, instructions=5)

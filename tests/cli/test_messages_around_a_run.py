@@ -57,7 +57,7 @@ def test_a_missing_path_is_named_as_missing(tmp_path, capsys, command):
 
 
 def _one_team_graph(path):
-    from mtpg.engine.workload import layered_graphs
+    from mtpg.engine.random_populations import layered_graphs
     from mtpg.io.serialize import save_graph
 
     pop, roots = layered_graphs(np.random.default_rng(0), 1, teams=1, programs=3)

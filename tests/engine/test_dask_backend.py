@@ -12,7 +12,7 @@ from mtpg.config import build_config
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.dask_backend import DaskEvaluator, plan_batches
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.envs.taskset.task_table import TaskTable
 from mtpg.evolve.columns import TIMING_COLUMNS
 from mtpg.evolve.trainer import Trainer

@@ -15,7 +15,7 @@ from mtpg.config import build_config
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.oracle import ReferenceAgent
-from mtpg.engine.workload import layered_graphs
+from mtpg.engine.random_populations import layered_graphs
 from mtpg.envs import TASK_PARAMS, env_observe, env_reset, env_step
 from mtpg.envs.specs.contract import STATE_SIZE, TASK_NAMES
 from mtpg.envs.taskset.episode_seeds import held_out_seeds

@@ -10,8 +10,8 @@ from graph_strategies import tangled_cases
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.ops import OP_COPY
+from mtpg.engine.random_populations import layered_graphs
 from mtpg.engine.trace import trace_sequence
-from mtpg.engine.workload import layered_graphs
 from mtpg.model.graph import Population, atomic
 from mtpg.model.instructions import (
     CONSTANTS,

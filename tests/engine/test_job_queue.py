@@ -15,7 +15,7 @@ import numpy as np
 from mtpg.engine.batch import BatchResult, Episodes, Jobs, run_jobs
 from mtpg.engine.compile import compile_population
 from mtpg.engine.episode_kernels import _fetch_add, run_jobs_parallel, run_jobs_queue
-from mtpg.engine.workload import layered_graphs
+from mtpg.engine.random_populations import layered_graphs
 from mtpg.envs import TASK_PARAMS
 from mtpg.envs.specs.contract import TASK_NAMES
 

@@ -14,7 +14,7 @@ from mtpg.engine.batch import Episodes, run_jobs
 from mtpg.engine.compile import compile_population
 from mtpg.engine.lane_graph import P_ACT, P_GLOBAL, localise, registers_to_zero, unlocalise
 from mtpg.engine.ops import OP_COPY
-from mtpg.engine.workload import layered_graphs, tangled_population
+from mtpg.engine.random_populations import layered_graphs, tangled_population
 from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.model.instructions import RegisterLayout
 

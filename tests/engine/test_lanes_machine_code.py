@@ -19,7 +19,7 @@ import numpy as np
 from mtpg.engine.batch import BatchResult, Episodes, Jobs
 from mtpg.engine.compile import compile_population
 from mtpg.engine.lanes import run_lanes_queue
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 pop = tangled_population(np.random.default_rng(0), 3, 10, 8, 3, 0.5)
 cp = compile_population(pop)
 eps = Episodes.grid([0, 3], [0])

@@ -11,7 +11,7 @@ import pytest
 from mtpg.engine.compile import compile_population
 from mtpg.engine.live import LiveDecider
 from mtpg.engine.oracle import ReferenceAgent
-from mtpg.engine.workload import layered_graphs
+from mtpg.engine.random_populations import layered_graphs
 from mtpg.model.instructions import RegisterLayout
 
 

@@ -8,8 +8,8 @@ from graph_strategies import tangled_cases
 from mtpg.engine.batch import Episodes, evaluate_roots, run_jobs
 from mtpg.engine.compile import compile_population
 from mtpg.engine.oracle import ReferenceAgent, reference_episode
+from mtpg.engine.random_populations import layered_graphs, tangled_population
 from mtpg.engine.trace import trace_sequence
-from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.model.graph import check_invariants
 from mtpg.model.instructions import BIG

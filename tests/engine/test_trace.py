@@ -48,7 +48,7 @@ def test_no_memory_mode_resets_last_write():
 
 def test_traced_episode_matches_batch_kernel():
     from mtpg.engine.batch import Episodes, evaluate_roots
-    from mtpg.engine.workload import layered_graphs
+    from mtpg.engine.random_populations import layered_graphs
 
     pop, roots = layered_graphs(np.random.default_rng(4), 6, teams=3, programs=5, instructions=6)
     cp = compile_population(pop, fold_constants=False)
@@ -67,7 +67,7 @@ def test_traced_episode_matches_batch_kernel():
 def test_a_run_whose_logs_overflow_is_played_again_with_room_for_all(monkeypatch):
     """Logs that outgrow the first buffers are counted, and the run is played again."""
     from mtpg.engine import record
-    from mtpg.engine.workload import layered_graphs
+    from mtpg.engine.random_populations import layered_graphs
 
     pop, roots = layered_graphs(np.random.default_rng(5), 2, teams=3, programs=5, instructions=6)
     cp = compile_population(pop, fold_constants=False)
@@ -89,7 +89,7 @@ def test_a_run_whose_logs_overflow_is_played_again_with_room_for_all(monkeypatch
 
 
 def test_a_traced_episode_ends_where_its_noise_row_ends():
-    from mtpg.engine.workload import layered_graphs
+    from mtpg.engine.random_populations import layered_graphs
     from mtpg.envs.specs.contract import ACROBOT
 
     pop, roots = layered_graphs(np.random.default_rng(4), 1, teams=2, programs=4, instructions=4)

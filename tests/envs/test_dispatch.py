@@ -15,9 +15,9 @@ import pytest
 from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.episode_kernels import run_jobs_queue
+from mtpg.engine.random_populations import tangled_population
 from mtpg.engine.record import new_recorder
 from mtpg.engine.trace import trace_episode
-from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe, env_reset, env_step
 from mtpg.envs.specs.contract import N_TASKS, STATE_SIZE, STEP_SLOT
 from mtpg.envs.specs.param_table import P_KIND, TASK_PARAMS

@@ -8,8 +8,8 @@ import pytest
 
 from mtpg.engine.batch import Episodes
 from mtpg.engine.compile import compile_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.engine.trace import trace_episode
-from mtpg.engine.workload import tangled_population
 from mtpg.envs import env_observe, env_reset, sample_start
 from mtpg.envs.gym_api.registration import register
 from mtpg.envs.taskset.episodes import draw_episodes, make_episodes

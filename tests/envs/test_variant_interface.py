@@ -17,7 +17,7 @@ from gymnasium.utils.env_checker import check_env
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.oracle import ReferenceAgent, reference_episode
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.envs import env_observe
 from mtpg.envs.gym_api.registration import register
 from mtpg.envs.taskset.task_table import TaskTable

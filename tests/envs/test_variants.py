@@ -10,8 +10,8 @@ from gymnasium.utils.env_checker import check_env
 from mtpg.engine.batch import Episodes, evaluate_roots
 from mtpg.engine.compile import compile_population
 from mtpg.engine.oracle import ReferenceAgent, reference_episode
+from mtpg.engine.random_populations import tangled_population
 from mtpg.engine.trace import trace_episode
-from mtpg.engine.workload import tangled_population
 from mtpg.envs import PREV_FORCE_SLOT, env_observe, env_reset, env_step
 from mtpg.envs.gym_api.registration import register
 from mtpg.envs.specs.contract import CARTPOLE

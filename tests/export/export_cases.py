@@ -7,8 +7,8 @@ requires the very same ``(a_d, a_c)`` bits at every decision.
 import numpy as np
 
 from mtpg.engine.compile import compile_population
+from mtpg.engine.random_populations import layered_graphs, tangled_population
 from mtpg.engine.trace import trace_sequence
-from mtpg.engine.workload import layered_graphs, tangled_population
 from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.export.harness import Stream, mismatches
 from mtpg.model.graph import Population, atomic

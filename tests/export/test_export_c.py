@@ -14,7 +14,7 @@ from export_cases import (
     sequence_stream,
 )
 
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.export.c import header_text, source_text, write_c
 from mtpg.export.common import prepare
 from mtpg.export.harness import Stream, engine_stream

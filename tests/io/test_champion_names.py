@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.io.rundir import (
     MAX_FILENAME,
     champion_filename,

@@ -6,7 +6,7 @@ file of a commit; the files must be byte for byte those written without it.
 
 import numpy as np
 
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.io._readable import dumps_readable
 from mtpg.io.serialize import graph_text, graph_to_dict
 

@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from mtpg.engine.workload import tangled_population
+from mtpg.engine.random_populations import tangled_population
 from mtpg.io import (
     CheckpointError,
     checkpoint_path,

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from mtpg.engine.oracle import ReferenceAgent
-from mtpg.engine.workload import layered_graphs
+from mtpg.engine.random_populations import layered_graphs
 from mtpg.io import (
     MetricsWriter,
     RunDirError,

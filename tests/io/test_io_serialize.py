@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from mtpg.engine.oracle import ReferenceAgent
-from mtpg.engine.workload import layered_graphs, tangled_population
+from mtpg.engine.random_populations import layered_graphs, tangled_population
 from mtpg.io import (
     FormatError,
     graph_from_dict,

@@ -25,7 +25,7 @@ import numpy as np
 from mtpg.engine.batch import BatchResult, Episodes, run_jobs
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.lanes import DEFAULT_LANES
-from mtpg.engine.workload import layered_graphs
+from mtpg.engine.random_populations import layered_graphs
 from mtpg.envs import CARTPOLE
 from mtpg.model.graph import Population
 

@@ -54,7 +54,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.runs.memorisation import probe_json, probe_target, probe_text
+    from mtpg.analysis.runs.champion_probe import probe_json, probe_target, probe_text
     from mtpg.cli.common import task_list
     from mtpg.cli.main import UsageError
     from mtpg.limits import LIMITS

@@ -110,7 +110,7 @@ def play_batch(
 def warm_up() -> int:
     """Loads (or compiles) the kernels in a worker process; returns its pid."""
     from mtpg.engine.compile import compile_population
-    from mtpg.engine.workload import layered_graphs
+    from mtpg.engine.random_populations import layered_graphs
 
     pop, roots = layered_graphs(np.random.default_rng(0), 1, teams=2, programs=2, instructions=2)
     evaluate_roots(compile_population(pop), roots, Episodes.grid([0], [0]))

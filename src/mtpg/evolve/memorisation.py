@@ -19,7 +19,7 @@ it (CartPole, Acrobot) or for a graph that never reads it. ``(b) - (c)`` is what
 training start states were worth. Scores are mean returns, also normalised against the
 reference best (0 = random play, 1 = reference best) and, given a denominator, against a
 single-task champion. Which graph of a run, and its episodes:
-:mod:`mtpg.analysis.runs.memorisation`.
+:mod:`mtpg.analysis.runs.champion_probe`.
 """
 
 from __future__ import annotations

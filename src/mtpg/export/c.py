@@ -6,7 +6,7 @@ The generated API::
     void mtpg_act(const double obs[2], int *a_d, double *a_c); /* one decision */
 
 Each program becomes a ``static`` function of straight-line code (introns removed,
-values known at export time substituted, see :mod:`mtpg.export.fold`) that runs on a
+values known at export time substituted, see :mod:`mtpg.export.lowering`) that runs on a
 ``static`` array of memory banks, so memory persists between calls until ``mtpg_reset``.
 Each team becomes a ``case`` of a loop in ``mtpg_act`` that runs all its programs in order
 and keeps the first highest bid among eligible programs, as the engine does. Compiled
@@ -28,7 +28,7 @@ engine ran with (the same libm; other libms may differ in the last bit).
 from __future__ import annotations
 
 from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, action_text
-from mtpg.export.fold import Operand
+from mtpg.export.lowering import Operand
 
 #: C library functions that are not correctly rounded, by the ops calling them. They are
 #: called through volatile pointers so that no compiler can evaluate them at compile time

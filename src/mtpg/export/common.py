@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from mtpg.engine.compile import effective_mask
-from mtpg.export.fold import Operand, Statement, lower
+from mtpg.export.lowering import Operand, Statement, lower
 from mtpg.model.graph import Population
 from mtpg.model.instructions import (
     BIG,
@@ -70,7 +70,7 @@ class ExportProgram:
         n_total: Instructions before intron removal.
         bank: Dense bank index.
         target: Dense team index it points to, or ``-1 - a`` for atomic action ``a``.
-        body: The statements to generate (:func:`mtpg.export.fold.lower`).
+        body: The statements to generate (:func:`mtpg.export.lowering.lower`).
         bid: The bid operand: ``("r", 0)`` or a literal ``("c", value)``.
         folded: Effective instructions evaluated at export time.
     """

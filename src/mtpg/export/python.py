@@ -19,7 +19,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, action_text
-from mtpg.export.fold import Operand
+from mtpg.export.lowering import Operand
 
 #: Expression of each protected operation (``d`` target, ``a``/``b`` operands).
 _OPS: dict[str, tuple[str, str]] = {

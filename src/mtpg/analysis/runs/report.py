@@ -2,7 +2,7 @@
 
 Every number comes from :mod:`mtpg.analysis.runs.reported_numbers` (the same definitions
 ``mtpg evaluate`` uses) or, for the memorisation probe of every run's all-task champion,
-:mod:`mtpg.analysis.runs.memorisation` (as ``mtpg probe``); runs are grouped by configuration
+:mod:`mtpg.analysis.runs.champion_probe` (as ``mtpg probe``); runs are grouped by configuration
 (:func:`mtpg.analysis.runs.loading.group_runs`) and a mixture of configurations beyond the
 ablation switches raises :class:`MixedRunsWarning`.
 """
@@ -18,9 +18,9 @@ import numpy as np
 
 from mtpg.analysis import html as pages
 from mtpg.analysis.runs import score_figures, statistics_figures
+from mtpg.analysis.runs.champion_probe import probe_html, probe_target
 from mtpg.analysis.runs.hierarchical_complexity import subset_complexity
 from mtpg.analysis.runs.loading import RunData, RunGroup, group_runs, load_run, reference_best
-from mtpg.analysis.runs.memorisation import probe_html, probe_target
 from mtpg.analysis.runs.reported_numbers import (
     BEST_RUN_RULE,
     SINGLE_RULE,

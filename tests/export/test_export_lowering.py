@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from mtpg.export.fold import Statement, lower
+from mtpg.export.lowering import Statement, lower
 from mtpg.model.instructions import OP_ADD, OP_EXP, OP_IF_LT, OP_MUL, RegisterLayout
 
 LAY = RegisterLayout()

@@ -89,6 +89,23 @@ def run(env, *args):
     return done.stdout
 
 
+def play(policy, env, episodes):
+    """Returns of ``policy`` in a plain Gymnasium loop on the first held-out seeds."""
+    returns = []
+    for k in range(episodes):
+        obs, _ = env.reset(seed=1_000_000 + k)
+        policy.reset()
+        total, done = 0.0, False
+        while not done:
+            action = policy.act(obs)
+            assert env.action_space.contains(action)
+            obs, reward, terminated, truncated, _ = env.step(action)
+            total += float(reward)
+            done = terminated or truncated
+        returns.append(total)
+    return returns
+
+
 def test_a_user_environment_trains_resumes_exactly_exports_and_acts_as_a_policy(
     tmp_path, user_module
 ):
@@ -111,20 +128,7 @@ def test_a_user_environment_trains_resumes_exactly_exports_and_acts_as_a_policy(
     assert scored[TASK]["episodes"] == 5
 
     # mtpg.Policy in a plain Gymnasium loop: the held-out seeds, the same returns bit for bit
-    policy = mtpg.Policy.load(whole)
-    env = gym.make("linemod:Line-v0")
-    returns = []
-    for k in range(5):
-        obs, _ = env.reset(seed=1_000_000 + k)
-        policy.reset()
-        total, done = 0.0, False
-        while not done:
-            action = policy.act(obs)
-            assert env.action_space.contains(action)
-            obs, reward, terminated, truncated, _ = env.step(action)
-            total += float(reward)
-            done = terminated or truncated
-        returns.append(total)
+    returns = play(mtpg.Policy.load(whole), gym.make("linemod:Line-v0"), 5)
     assert np.mean(returns) == scored[TASK]["mean"]
     assert np.std(returns) == scored[TASK]["std"]
 
@@ -154,18 +158,7 @@ def test_gymnasium_cartpole_evaluates_as_a_plain_gymnasium_loop_replays_it(tmp_p
     args = [*SMALL, "--tasks", "gym:CartPole-v1", "--generations", "2", "--out", str(folder)]
     run(env, "train", *args)
     scored = json.loads(run(env, "evaluate", str(folder), "--episodes", "3", "--json"))
-    policy = mtpg.Policy.load(folder)
-    cart = gym.make("CartPole-v1")
-    returns = []
-    for k in range(3):
-        obs, _ = cart.reset(seed=1_000_000 + k)
-        policy.reset()
-        total, done = 0.0, False
-        while not done:
-            obs, reward, terminated, truncated, _ = cart.step(policy.act(obs))
-            total += float(reward)
-            done = terminated or truncated
-        returns.append(total)
+    returns = play(mtpg.Policy.load(folder), gym.make("CartPole-v1"), 3)
     assert np.mean(returns) == scored["gym:CartPole-v1"]["mean"]
 
 

@@ -24,6 +24,7 @@ import mtpg.envs  # noqa: F401  (registers the Gymnasium ids mtpg/<Task>-v0; num
 #: Public name -> the module defining it (imported when the name is first used).
 _PUBLIC = {
     "Champion": "mtpg.api",
+    "CompiledTask": "mtpg.envs.specs.compiled_task",
     "Config": "mtpg.config",
     "ConfigError": "mtpg.config",
     "Evaluation": "mtpg.api_evaluation",

@@ -24,7 +24,9 @@ policy has its own, so several live side by side in one process.
 for a Gymnasium task (``gym:ID``) the environment's raw observation, scaled as in training
 (:mod:`mtpg.envs.specs.gym_task`), and its own action; for one of the registered tasks the
 observation of its ``mtpg/<Task>-v0`` environment (two inputs in [-1, 1]) and the paper's
-pair ``(a_d, array([a_c]))``.
+pair ``(a_d, array([a_c]))``; for a compiled task (``module:ATTR``) what its ``observe``
+writes and the pair ``(a_d, array([m0]))``, ``a_d`` in its ``n_actions`` and ``m0`` the raw
+memory value its ``step`` gets clipped to its bound.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ import numpy as np
 
 from mtpg.engine.compile import compile_population
 from mtpg.engine.live import LiveDecider
+from mtpg.envs.specs.compiled_task import CompiledTask
 from mtpg.envs.specs.gym_task import GymTask
 
 
@@ -59,6 +62,8 @@ class Policy:
         self.task = table.names[0]
         spec = table.spec(table.ids[0])
         self._gym: GymTask | None = spec if isinstance(spec, GymTask) else None
+        #: A compiled task's discrete actions (its a_d is folded onto them), else 0.
+        self._fold = spec.n_actions if isinstance(spec, CompiledTask) else 0
         n_cont = self._gym.n_continuous if self._gym else 1
         cp = compile_population(population, no_memory=no_memory)
         self.root = int(root)
@@ -119,4 +124,5 @@ class Policy:
             return self._gym.action(a_d[0], a_c[0])
         o = np.asarray(obs, dtype=np.float64).reshape(1, -1)
         a_d, a_c = self._live.decide(self._which, o)
-        return int(a_d[0]), a_c[0].copy()
+        a = int(a_d[0]) % self._fold if self._fold else int(a_d[0])
+        return a, a_c[0].copy()

@@ -32,6 +32,7 @@ from typing import TextIO
 from tqdm import tqdm
 from tqdm.contrib.logging import logging_redirect_tqdm
 
+from mtpg.envs.specs.compiled_task import is_compiled_name
 from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.specs.gym_task import short as gym_short
 from mtpg.envs.specs.registry import TASKS
@@ -46,6 +47,8 @@ def _short(task: str) -> str:
     """A task's short label: the registry's, a variant its base's, a ``gym:`` task its own."""
     if is_gym(task):
         return gym_short(task)
+    if is_compiled_name(task):  # module:ATTR: the attribute
+        return task.rsplit(":", 1)[1][:4]
     return SHORT[task.split("[", 1)[0]]
 
 

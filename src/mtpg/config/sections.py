@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from mtpg.envs.specs.compiled_task import is_compiled_name
 from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.specs.registry import PAPER_TASKS, TASK_NAMES
 from mtpg.envs.taskset.task_table import TaskTable, parse_given
@@ -184,7 +185,7 @@ class EvaluationConfig:
         _check(len(self.tasks) >= 1, "evaluation.tasks", "must name at least one task", self.tasks)
         for name in self.tasks:
             _check(isinstance(name, str), "evaluation.tasks", "must hold task names", name)
-            if not is_variant(name) and not is_gym(name):
+            if not is_variant(name) and not is_gym(name) and not is_compiled_name(name):
                 _check(
                     name in TASK_NAMES,
                     "evaluation.tasks",

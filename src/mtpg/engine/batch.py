@@ -15,9 +15,16 @@ from mtpg.engine.compile import CompiledPopulation
 from mtpg.engine.episode_kernels import run_jobs_parallel, run_jobs_queue
 from mtpg.engine.gym_play import play_gym
 from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_parallel, run_lanes_queue
+from mtpg.engine.user_kernels import kernels as user_kernels
 from mtpg.envs.specs.gym_task import TRAIN_RESET_OFFSET
 from mtpg.envs.taskset.episodes import draw_episodes
-from mtpg.envs.taskset.task_table import BUILTIN_SHAPE, GYM_ID_BASE, REGISTERED, TaskTable
+from mtpg.envs.taskset.task_table import (
+    BUILTIN_SHAPE,
+    GYM_ID_BASE,
+    REGISTERED,
+    USER_ID_BASE,
+    TaskTable,
+)
 
 
 class Episodes(NamedTuple):
@@ -53,7 +60,7 @@ class Episodes(NamedTuple):
         seeds = np.asarray(seeds, dtype=np.int64)
         starts, noise, obs_noise = draw_episodes(tasks, seeds, table)
         fields = (tasks, seeds, starts, noise, obs_noise, table.params)
-        return GymEpisodes.holding(fields, table.gym) if table.gym else Episodes(*fields)
+        return GymEpisodes.holding(fields, table.gym, table.user)
 
     @property
     def gym(self) -> tuple:
@@ -62,6 +69,16 @@ class Episodes(NamedTuple):
         Task ``k`` (:class:`~mtpg.envs.specs.gym_task.GymTask`) has id ``GYM_ID_BASE + k``.
         """
         return getattr(self, "__dict__", {}).get("gym_tasks", ())
+
+    @property
+    def user(self) -> tuple:
+        """The compiled tasks of users' modules of the table (``()`` for none).
+
+        Task ``k`` (:class:`~mtpg.envs.specs.compiled_task.CompiledTask`) has id
+        ``USER_ID_BASE + k``; :func:`run_jobs` plays the table with the engine's loop
+        compiled for them (:mod:`mtpg.engine.user_kernels`).
+        """
+        return getattr(self, "__dict__", {}).get("user_tasks", ())
 
     @classmethod
     def single(
@@ -112,25 +129,35 @@ class Episodes(NamedTuple):
     def with_noise(self, noise: np.ndarray) -> Episodes:
         """The same table with another noise matrix (its Gymnasium tasks kept)."""
         fields = (*self[:3], noise, *self[4:])
-        return GymEpisodes.holding(fields, self.gym) if self.gym else Episodes(*fields)
+        return GymEpisodes.holding(fields, self.gym, self.user)
 
     def compiled(self) -> Episodes:
+        """The table without its Gymnasium tasks (its compiled tasks kept)."""
+        return GymEpisodes.holding(tuple(self), (), self.user)
+
+    def plain(self) -> Episodes:
         """The table as the compiled kernels take it (a plain :class:`Episodes`)."""
         return Episodes(*self) if type(self) is not Episodes else self
 
 
 class GymEpisodes(Episodes):
-    """An :class:`Episodes` table that also holds its task table's Gymnasium tasks.
+    """An :class:`Episodes` table that also holds its task table's Gymnasium and compiled tasks.
 
-    The tasks are an attribute, not a field, so the compiled kernels' argument type stays
-    the six arrays (they are given :meth:`Episodes.compiled`).
+    The tasks are attributes, not fields, so the compiled kernels' argument type stays
+    the six arrays (they are given :meth:`Episodes.plain`).
     """
 
     @classmethod
-    def holding(cls, fields: tuple, gym: tuple) -> GymEpisodes:
-        """The table of ``fields`` holding the Gymnasium tasks ``gym``."""
+    def holding(cls, fields: tuple, gym: tuple, user: tuple = ()) -> Episodes:
+        """The table of ``fields`` holding the Gymnasium tasks ``gym`` and compiled ``user``.
+
+        A plain :class:`Episodes` when both are empty.
+        """
+        if not gym and not user:
+            return Episodes(*fields)
         table = cls(*fields)
         table.__dict__["gym_tasks"] = tuple(gym)
+        table.__dict__["user_tasks"] = tuple(user)
         return table
 
 
@@ -211,7 +238,7 @@ def run_jobs(
         raise ValueError(f"lanes must be >= 0, got {lanes}")
     if episodes.gym:
         return _run_mixed(cp, job_roots, job_episodes, episodes, threads, no_memory, block, lanes)
-    check_fits_compiled_tasks(cp)
+    check_fits_compiled_tasks(cp, episodes, job_episodes)
     out = BatchResult.zeros(len(job_roots))
     jobs = Jobs(
         np.ascontiguousarray(job_roots, dtype=np.int64),
@@ -219,26 +246,57 @@ def run_jobs(
     )
     queue = np.zeros(1, dtype=np.int64)
     g = cp.with_memory_mode(no_memory).graph
+    queue_kernel, parallel_kernel = run_jobs_queue, run_jobs_parallel
+    lanes_kernel, lanes_parallel = run_lanes_queue, run_lanes_parallel
+    if episodes.user:  # the loops compiled for the table's compiled tasks
+        queue_kernel, parallel_kernel, lanes_kernel, lanes_parallel = user_kernels(
+            episodes.user, USER_ID_BASE, episodes.starts.shape[1]
+        )
+        if cp.layout.n_obs != 2:  # the lane engine reads two inputs
+            lanes = 0
+        episodes = episodes.plain()
     if threads == 1 and lanes == 0:
-        run_jobs_queue(queue, block, jobs, episodes, out, g)
+        queue_kernel(queue, block, jobs, episodes, out, g)
     elif threads == 1:
-        run_lanes_queue(queue, block, lanes, jobs, episodes, out, g)
+        lanes_kernel(queue, block, lanes, jobs, episodes, out, g)
     else:
         threads = min(threads, numba.config.NUMBA_NUM_THREADS)
         numba.set_num_threads(threads)
         if lanes == 0:
-            run_jobs_parallel(threads, queue, block, jobs, episodes, out, g)
+            parallel_kernel(threads, queue, block, jobs, episodes, out, g)
         else:
-            run_lanes_parallel(threads, queue, block, lanes, jobs, episodes, out, g)
+            lanes_parallel(threads, queue, block, lanes, jobs, episodes, out, g)
     return out
 
 
-def check_fits_compiled_tasks(cp: CompiledPopulation) -> None:
-    """Refuses a graph the compiled tasks cannot play (they observe 2 inputs, take 3 actions).
+def check_fits_compiled_tasks(
+    cp: CompiledPopulation, episodes: Episodes | None = None, rows: np.ndarray | None = None
+) -> None:
+    """Refuses a graph the compiled tasks cannot play.
+
+    The registered tasks observe 2 inputs and take 3 actions; a compiled task of a user's
+    module observes its ``n_obs`` inputs (a graph of fewer inputs cannot play it).
+
+    Args:
+        cp: The compiled population.
+        episodes: The episode table (its compiled tasks checked too), or None.
+        rows: The rows of ``episodes`` the jobs play (all when None).
 
     Raises:
         ValueError: One line naming the layout size at fault.
     """
+    user = episodes.user if episodes is not None else ()
+    if user:
+        tasks = episodes.tasks if rows is None else episodes.tasks[np.asarray(rows)]
+        present = set(np.unique(tasks).tolist())
+        for k, task in enumerate(user):
+            if USER_ID_BASE + k in present and cp.layout.n_obs < task.n_obs:
+                raise ValueError(
+                    f"layout.n_obs must be >= {task.n_obs} to play {task.name} "
+                    f"(it observes {task.n_obs} inputs), got {cp.layout.n_obs}"
+                )
+        if all(t >= USER_ID_BASE for t in present):
+            return
     n_obs, n_actions, _ = BUILTIN_SHAPE
     if cp.layout.n_obs < n_obs:
         raise ValueError(

@@ -54,6 +54,8 @@ def observes_noise(task: str) -> bool:
     table = TaskTable.from_names([task])
     if table.is_gym(table.ids[0]):  # a Gymnasium task has no noise input
         return False
+    if table.is_user(table.ids[0]):  # a compiled task says whether it reads one
+        return table.specs[0].noise_input
     return len(table.specs[0].observed_slots) < 2
 
 

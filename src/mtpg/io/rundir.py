@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from mtpg._faults import point
+from mtpg.envs.specs.compiled_task import is_compiled_name
 from mtpg.envs.specs.contract import TASK_NAMES
 from mtpg.envs.specs.gym_task import is_gym
 from mtpg.io._atomic import atomic_write_bytes, is_temp_file
@@ -458,10 +459,12 @@ def _digest(text: str, n: int) -> str:
 def _file_safe(task: str) -> str:
     """A task name as a file name may hold it.
 
-    A ``gym:`` name's colons, slashes and quotes become ``_`` (the file's ``tasks`` entry
-    keeps the name itself).
+    A ``gym:`` or compiled (``module:ATTR``) name's colons, slashes and quotes become ``_``
+    (the file's ``tasks`` entry keeps the name itself).
     """
-    return re.sub(r"[^A-Za-z0-9._\-\[\]=;()+,]", "_", task) if is_gym(task) else task
+    if is_gym(task) or is_compiled_name(task):
+        return re.sub(r"[^A-Za-z0-9._\-\[\]=;()+,]", "_", task)
+    return task
 
 
 def champion_filename(task_names: tuple[str, ...]) -> str:

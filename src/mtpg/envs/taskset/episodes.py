@@ -22,19 +22,28 @@ def sample_start(task: int, rng: np.random.Generator, table: TaskTable = REGISTE
         table: The task table (the registered tasks by default).
 
     Returns:
-        A float64 array of ``STATE_SIZE`` slots: the physical state, then the previous force
-        (``+F``) and the step count (0).
+        A float64 array of :func:`state_width` slots: the physical state, then the previous
+        force (``+F``) and the step count (0); a compiled task's state from ``STATE_SIZE``.
 
     Raises:
         ValueError: For an id the table does not know.
     """
     spec = table.spec(int(task))
+    start = np.zeros(state_width(table), dtype=np.float64)
+    if table.is_user(int(task)):  # its own slots, after the registered tasks' (user_dispatch)
+        phys = spec.start(rng)
+        start[STATE_SIZE : STATE_SIZE + phys.shape[0]] = phys
+        return start
     phys = np.asarray(spec.kernel("sample_start")(rng), dtype=np.float64)
-    start = np.zeros(STATE_SIZE, dtype=np.float64)
     start[: phys.shape[0]] = phys
     start[PREV_FORCE_SLOT] = spec.params[1]
     start[STEP_SLOT] = 0.0
     return start
+
+
+def state_width(table: TaskTable) -> int:
+    """Slots of a state array of ``table``'s tasks: ``STATE_SIZE``, more with compiled tasks."""
+    return STATE_SIZE + max((t.state_dim for t in table.user), default=0)
 
 
 def make_episodes(
@@ -93,8 +102,12 @@ def draw_episodes(
     gym = {t for t in specs if table.is_gym(t)}
     limits = {t: spec.max_steps for t, spec in specs.items() if t not in gym}
     width = max(limits.values()) + 1 if limits else 1
-    noisy = {t for t, spec in specs.items() if t not in gym and obs_noise_sd(spec) > 0.0}
-    starts = np.zeros((n, STATE_SIZE), dtype=np.float64)
+    noisy = {
+        t
+        for t, spec in specs.items()
+        if t not in gym and not table.is_user(t) and obs_noise_sd(spec) > 0.0
+    }
+    starts = np.zeros((n, state_width(table)), dtype=np.float64)
     noise = np.zeros((n, width), dtype=np.float64)
     obs_noise = np.zeros((n, width if noisy else 0, 2), dtype=np.float64)
     for i in range(n):

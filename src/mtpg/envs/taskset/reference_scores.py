@@ -29,6 +29,8 @@ from functools import cache
 import numpy as np
 
 from mtpg.envs.dynamics.rollout import run_episodes, run_time_optimal
+from mtpg.envs.dynamics.user_dispatch import generate
+from mtpg.envs.specs.compiled_task import CompiledTask
 from mtpg.envs.specs.contract import CARTCENTERING
 from mtpg.envs.specs.gym_task import GymTask
 from mtpg.envs.specs.gym_task import measure_random as measure_gym_random
@@ -149,6 +151,8 @@ def reference_of(task: int | str, table: TaskTable = REGISTERED) -> Reference:
     spec = table.spec(task)
     if isinstance(spec, GymTask):
         return gym_reference(spec, table.given_reference(spec.name))
+    if isinstance(spec, CompiledTask):
+        return compiled_reference(spec, table.given_reference(spec.name))
     if not spec.base:
         return spec.reference
     given = table.given_reference(spec.name)
@@ -175,6 +179,56 @@ def gym_reference(task: GymTask, given: GivenReference | None) -> Reference:
     if given is None:
         return Reference(*random, NONE, NONE, f"{how}; no best given: scores are raw")
     return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")
+
+
+def compiled_reference(task: CompiledTask, given: GivenReference | None) -> Reference:
+    """A compiled task's reference scores: random play measured (or given), best given.
+
+    Without a given best, ``best`` is NaN: its scores are reported raw, not normalised.
+    """
+    if given is not None and given.random is not None:
+        random, how = (given.random, NONE), "random given"
+    else:
+        random, how = measure_compiled_random(task.name), "random measured"
+    if given is None:
+        return Reference(*random, NONE, NONE, f"{how}; no best given: scores are raw")
+    return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")
+
+
+#: Episodes of the random-agent measurement of a compiled task of a user's module.
+N_COMPILED_RANDOM_EPISODES = 1000
+
+
+@cache
+def measure_compiled_random(name: str, n: int = N_COMPILED_RANDOM_EPISODES) -> tuple[float, float]:
+    """The random agent's (mean, standard deviation) on a compiled task, measured once.
+
+    The registered tasks' convention (module docstring) over ``n`` episodes, with ``a_d``
+    uniform on the task's ``n_actions`` actions; the episodes step through the task's
+    generated dispatch from Python. A pure function of the name (the task's module).
+    """
+    table = TaskTable.from_names([name])
+    task = table.ids[0]
+    spec = table.spec(task)
+    reset, observe, step = generate(table.user, task)
+    rng = np.random.default_rng(RANDOM_ACTION_SEED)
+    starts, noise = make_episodes(np.full(n, task), RANDOM_SEED_BASE + np.arange(n), table)
+    a_d = rng.integers(0, max(spec.n_actions, 1), (n, spec.max_steps))
+    a_c = rng.uniform(-spec.bound, spec.bound, (n, spec.max_steps))
+    p = table.params[task]
+    state = np.zeros(starts.shape[1])
+    obs = np.zeros(spec.n_obs)
+    returns = np.zeros(n)
+    for i in range(n):
+        reset(task, table.params, starts[i], state)
+        observe(task, p, state, noise[i, 0], obs)
+        for t in range(spec.max_steps):
+            reward, terminated, truncated = step(task, p, state, a_d[i, t], a_c[i, t])
+            returns[i] += reward
+            if terminated or truncated:
+                break
+            observe(task, p, state, noise[i, t + 1], obs)
+    return float(returns.mean()), float(returns.std())
 
 
 def normalise(

@@ -24,6 +24,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from mtpg.envs.specs.compiled_task import CompiledTask, is_compiled_name
+from mtpg.envs.specs.compiled_task import load as load_compiled
 from mtpg.envs.specs.gym_task import GymTask, is_gym
 from mtpg.envs.specs.param_table import TASK_PARAMS, param_row, params_table
 from mtpg.envs.specs.registry import TASK_NAMES, TASKS
@@ -32,6 +34,8 @@ from mtpg.envs.taskset.variants import canonical, is_variant, variant_row, varia
 
 #: The first variant id of a table (registered tasks keep 0..).
 VARIANT_ID_BASE = 256
+#: The first id of a compiled task of a user's module (:mod:`mtpg.envs.specs.compiled_task`).
+USER_ID_BASE = 512
 #: The first Gymnasium task id of a table (:mod:`mtpg.envs.specs.gym_task`): tasks that step in
 #: Python, never in the compiled kernels.
 GYM_ID_BASE = 1 << 20
@@ -75,11 +79,11 @@ def parse_given(text: str) -> GivenReference:
     task, sep, rest = (s.strip() for s in text.partition(": " if ": " in text else ":"))
     if not sep or not task:
         raise ValueError(f"{text!r}: write TASK: best=NUMBER[, random=NUMBER], source=TEXT")
-    if is_gym(task):
-        pass  # a Gymnasium task's scores are given or raw
+    if is_gym(task) or is_compiled_name(task):
+        pass  # a Gymnasium or compiled task's scores are given or raw
     elif not is_variant(task):
         raise ValueError(f"{task}: a registered task's reference scores are the registry's")
-    if canonical(task) != task:
+    if not is_compiled_name(task) and canonical(task) != task:
         raise ValueError(f"{task}: spell it {canonical(task)!r}")
     head, sep, source = rest.partition("source=")
     if not sep or not source.strip():
@@ -115,6 +119,8 @@ class TaskTable:
         params: float64 ``[ids, N_PARAMS]`` read-only parameter table the kernels index.
         given: Reference scores given for variants of the table, one per variant at most.
         gym: The table's Gymnasium tasks; task ``k`` has id ``GYM_ID_BASE + k``.
+        user: The table's compiled tasks of users' modules; task ``k`` has id
+            ``USER_ID_BASE + k``.
     """
 
     names: tuple[str, ...]
@@ -123,6 +129,7 @@ class TaskTable:
     params: np.ndarray
     given: tuple[GivenReference, ...] = ()
     gym: tuple[GymTask, ...] = ()
+    user: tuple[CompiledTask, ...] = ()
 
     @classmethod
     def from_names(
@@ -139,16 +146,20 @@ class TaskTable:
             ValueError: One line naming the fault: an unknown task or a bad variant, a bad
                 reference entry, one for a task not among ``names``, or two for one task.
         """
-        names = tuple(canonical(n) for n in names)
+        names = tuple(n if is_compiled_name(n) else canonical(n) for n in names)
         variants: list[TaskSpec] = []
         gym: list[GymTask] = []
+        user: list[CompiledTask] = []
         for name in dict.fromkeys(names):
-            if is_gym(name):
+            if is_compiled_name(name):
+                user.append(load_compiled(name))
+            elif is_gym(name):
                 gym.append(GymTask.from_name(name))
             elif is_variant(name):
                 variants.append(variant_spec(name))
         var_ids = {v.name: VARIANT_ID_BASE + k for k, v in enumerate(variants)}
         var_ids.update({t.name: GYM_ID_BASE + k for k, t in enumerate(gym)})
+        var_ids.update({t.name: USER_ID_BASE + k for k, t in enumerate(user)})
         ids = tuple(var_ids[n] if n in var_ids else TASK_NAMES.index(n) for n in names)
         given: dict[str, GivenReference] = {}
         for entry in references:
@@ -159,18 +170,22 @@ class TaskTable:
                 raise ValueError(f"{ref.task}: reference scores given twice")
             given[ref.task] = ref
         params = TASK_PARAMS
-        if variants:
+        if variants or user:
             padding = [param_row((1.0, 0.0), -1)] * (VARIANT_ID_BASE - len(TASK_PARAMS))
             rows = [*TASK_PARAMS, *padding, *(variant_row(v) for v in variants)]
+            if user:
+                rows += [param_row((1.0, 0.0), -1)] * (USER_ID_BASE - len(rows))
+                rows += [param_row(t.row(), USER_ID_BASE + k) for k, t in enumerate(user)]
             params = params_table(rows)
-        compiled = [n for n in names if not is_gym(n)]
-        many = [t.name for t in gym if t.n_actions > BUILTIN_SHAPE[1]]
+        compiled = [n for n in names if not is_gym(n) and not is_compiled_name(n)]
+        many = [t.name for t in (*gym, *user) if t.n_actions > BUILTIN_SHAPE[1]]
         if compiled and many:
             raise ValueError(
                 f"{many[0]} takes more than {BUILTIN_SHAPE[1]} discrete actions, which the "
                 f"registered tasks ({compiled[0]}) cannot play; train it without them"
             )
-        return cls(names, ids, tuple(variants), params, tuple(given.values()), tuple(gym))
+        table = (names, ids, tuple(variants), params, tuple(given.values()), tuple(gym))
+        return cls(*table, tuple(user))
 
     def id_of(self, name: str) -> int:
         """The id of a registered task, or of a variant of this table (any spelling).
@@ -180,6 +195,9 @@ class TaskTable:
         """
         if name in TASK_NAMES:
             return TASK_NAMES.index(name)
+        for k, task in enumerate(self.user):
+            if task.name == name:
+                return USER_ID_BASE + k
         key = canonical(name)
         for k, spec in enumerate(self.variants):
             if spec.name == key:
@@ -189,7 +207,7 @@ class TaskTable:
                 return GYM_ID_BASE + k
         raise ValueError(f"task {key!r} is not in this task table ({', '.join(self.names)})")
 
-    def spec(self, task: int | str) -> TaskSpec | GymTask:
+    def spec(self, task: int | str) -> TaskSpec | GymTask | CompiledTask:
         """The spec of a task id or name of this table (a Gymnasium task's :class:`GymTask`).
 
         Raises:
@@ -200,10 +218,12 @@ class TaskTable:
             raise ValueError(f"unknown task id {i}; valid ids are {self.id_ranges()}")
         if i >= GYM_ID_BASE:
             return self.gym[i - GYM_ID_BASE]
+        if i >= USER_ID_BASE:
+            return self.user[i - USER_ID_BASE]
         return TASKS[i] if i < len(TASKS) else self.variants[i - VARIANT_ID_BASE]
 
     @property
-    def specs(self) -> tuple[TaskSpec | GymTask, ...]:
+    def specs(self) -> tuple[TaskSpec | GymTask | CompiledTask, ...]:
         """The specs of the run's tasks, in ``names`` order."""
         return tuple(self.spec(i) for i in self.ids)
 
@@ -213,11 +233,16 @@ class TaskTable:
             0 <= task < len(TASKS)
             or 0 <= task - VARIANT_ID_BASE < len(self.variants)
             or 0 <= task - GYM_ID_BASE < len(self.gym)
+            or 0 <= task - USER_ID_BASE < len(self.user)
         )
 
     def is_gym(self, task: int) -> bool:
         """Whether a task id of this table is a Gymnasium task (it steps in Python)."""
         return task >= GYM_ID_BASE
+
+    def is_user(self, task: int) -> bool:
+        """Whether a task id of this table is a compiled task of a user's module."""
+        return USER_ID_BASE <= task < GYM_ID_BASE
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -228,7 +253,9 @@ class TaskTable:
         action ``a`` onto ``a mod n`` (:mod:`mtpg.envs.specs.gym_task`).
         """
         shapes = [
-            (t.n_obs, t.n_actions, t.n_continuous) if self.is_gym(i) else BUILTIN_SHAPE
+            (t.n_obs, t.n_actions, t.n_continuous)
+            if self.is_gym(i) or self.is_user(i)
+            else BUILTIN_SHAPE
             for i, t in zip(self.ids, self.specs, strict=True)
         ]
         n_obs, n_act, n_cont = (max(column) for column in zip(*shapes, strict=True))
@@ -239,6 +266,8 @@ class TaskTable:
         text = f"0..{len(TASKS) - 1}"
         if self.variants:
             text += f", {VARIANT_ID_BASE}..{VARIANT_ID_BASE + len(self.variants) - 1}"
+        if self.user:
+            text += f", {USER_ID_BASE}..{USER_ID_BASE + len(self.user) - 1}"
         if self.gym:
             text += f", {GYM_ID_BASE}..{GYM_ID_BASE + len(self.gym) - 1}"
         return text

@@ -44,6 +44,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from mtpg.envs.specs.compiled_task import is_compiled_name
 from mtpg.envs.specs.gym_task import canonical as gym_canonical
 from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.specs.param_table import OBS_AS_IS, OBS_COS, OBS_SIN, OBS_WRAP, param_row
@@ -197,11 +198,13 @@ def canonical(text: str) -> str:
     """
     if is_gym(text):
         return gym_canonical(text)
+    if is_compiled_name(text):  # module:ATTR of a compiled task, as written
+        return text
     if not is_variant(text):
         if text not in TASK_NAMES:
             raise ValueError(
                 f"unknown task {text!r}; choose from {', '.join(TASK_NAMES)} "
-                "or a Gymnasium environment, gym:ID"
+                "or a Gymnasium environment, gym:ID, or a compiled task, module:ATTR"
             )
         return text
     base, settings = parse(text)
@@ -260,6 +263,8 @@ def from_tables(tables: object) -> list[str]:
 def order_key(name: str) -> tuple[int, int, str]:
     """Sorts task names by registry id, each variant after its base, variants by name."""
     if is_gym(name):  # after every registered task and variant, by name
+        return (len(TASK_NAMES), 1, name)
+    if is_compiled_name(name):  # after every registered task and variant, before gym:
         return (len(TASK_NAMES), 0, name)
     base = name.split("[", 1)[0]
     return (TASK_NAMES.index(base), int(is_variant(name)), name)

@@ -79,6 +79,23 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         " kernel, one job at a time, the like for like of the scalar C port)",
     )
     eng.set_defaults(func=run)
+    tasks = sub.add_parser(
+        "tasks",
+        help="training speed: built-in CartPole, CartPole as a compiled user task, gym:CartPole-v1",
+        description=(
+            "Trains the same preset from the same seed on the built-in CartPole, on "
+            "CartPole written as a compiled task of a user's module (mtpg.bench.user_cartpole; "
+            "its run is identical to the built-in's) and on Gymnasium's CartPole-v1 (stepped "
+            "in Python), each in a fresh process, the arms in turn; reports the median "
+            "decisions per evaluation second (generation 1, which compiles, left out). "
+            "Prints a summary, then one JSON object as the last line."
+        ),
+    )
+    tasks.add_argument("--preset", default="demo", help="preset trained (demo)")
+    tasks.add_argument("--generations", type=int, default=30, help="generations per run (30)")
+    tasks.add_argument("--repeats", type=int, default=3, help="rounds, median reported (3)")
+    tasks.add_argument("--seed", type=int, default=1, help="run seed (1)")
+    tasks.set_defaults(func=_run_tasks)
     bench.set_defaults(func=lambda _args: _help(bench))
 
 
@@ -89,6 +106,26 @@ def _help(parser: argparse.ArgumentParser) -> int:
 
 def _fmt(value: float | None, unit: str = "") -> str:
     return "n/a" if value is None else f"{value:,.0f}{unit}"
+
+
+def _run_tasks(args: argparse.Namespace) -> int:
+    """``mtpg bench tasks``: prints the summary and the JSON line."""
+    from mtpg.bench.engine import machine_info
+    from mtpg.bench.tasks import benchmark
+
+    try:
+        r = benchmark(args.preset, args.generations, args.repeats, args.seed)
+    except RuntimeError as exc:
+        raise SystemExit(f"mtpg bench tasks: {exc}") from None
+    m = machine_info()
+    r["machine"] = m
+    print(f"\ntraining speed, {args.preset} preset, {args.generations} generations ({m['cpu']})")
+    for label, arm in r["arms"].items():
+        print(f"  {label:<20} {arm['decisions_per_s']:>12,.0f} decisions/s  ({arm['task']})")
+    same = "identical runs" if r["compiled_run_identical_decisions"] else "runs differ"
+    print(f"  compiled / built-in  {r['compiled_vs_built_in']:.2f}  ({same})")
+    print(json.dumps(r))
+    return 0
 
 
 def _run_late(args: argparse.Namespace, log) -> int:

@@ -244,3 +244,55 @@ def test_the_task_benchmark_runs_its_three_arms_and_the_compiled_run_is_identica
     result = json.loads(done.stdout.strip().splitlines()[-1])
     assert result["compiled_run_identical_decisions"]
     assert all(arm["decisions_per_s"] > 0 for arm in result["arms"].values())
+
+
+CONTINUOUS = textwrap.dedent(
+    '''
+    """A task of one continuous action and no discrete one: push x to 0 with a_c."""
+    import numpy as np
+    from numba import njit
+
+    from mtpg import CompiledTask
+
+
+    @njit
+    def observe(p, s, noise, obs):
+        obs[0] = s[0]
+
+
+    @njit
+    def step(p, s, a_d, a_c):
+        s[1] = a_d  # always 0: the task takes no discrete action
+        s[0] = s[0] + 0.1 * a_c
+        return -abs(s[0]), False
+
+
+    def start(rng):
+        return np.array([rng.uniform(-1.0, 1.0), 0.0])
+
+
+    PUSH = CompiledTask("Push", observe, step, start, n_obs=1, n_actions=0, n_continuous=1,
+                        state_dim=2, max_steps=20, action_bound=2.0)
+    '''
+)
+
+
+def test_a_task_without_a_discrete_action_reads_its_clipped_continuous_one(tmp_path, user_module):
+    from mtpg.engine.batch import Episodes, evaluate_roots
+    from mtpg.engine.compile import compile_population
+    from mtpg.engine.random_populations import layered_graphs
+    from mtpg.envs.taskset.task_table import TaskTable
+    from mtpg.model.instructions import RegisterLayout
+
+    folder = Path(user_module["PYTHONPATH"].split(os.pathsep)[0])
+    (folder / "userpush.py").write_text(CONTINUOUS)
+    table = TaskTable.from_names(["userpush:PUSH"])
+    assert table.shape == (1, 1, 1)
+    layout = RegisterLayout(n_obs=1, n_actions=1)
+    pop, roots = layered_graphs(np.random.default_rng(5), 10, layout=layout)
+    returns, result = evaluate_roots(
+        compile_population(pop), roots, Episodes.grid([512], [1], table)
+    )
+    assert (result.steps == 20).all()
+    # |x| moves at most 0.1 * 2.0 a step: the clip to action_bound holds
+    assert (returns >= -20 * (1.0 + 0.2 * 20)).all() and np.isfinite(returns).all()

@@ -164,8 +164,9 @@ def test_a_compiled_task_trains_resumes_exactly_and_acts_as_a_policy(tmp_path, u
         returns.append(total)
     assert np.mean(returns) == scored[TASK]["mean"]
     assert np.std(returns) == scored[TASK]["std"]
-    for command in (["probe", str(whole)], ["show", str(whole)]):
-        run(user_module, *command)
+    probe = run(user_module, "probe", str(whole))
+    assert " n/a " in probe and "nan" not in probe  # raw scores: no normalised ones
+    run(user_module, "show", str(whole))
 
 
 BAD = {

@@ -306,13 +306,18 @@ def probe_text(probe: Probe) -> list[str]:
             redraws = _redraw_scores(p, pick)
             lo, hi = _interval(redraws)
             lines.append(
-                f"{t:<22} {'yes' if p.observes_noise else 'no':>5} {s['train']:>10.3f} "
-                f"{s['fresh_noise']:>10.3f} {s['test']:>10.3f} {d['noise']:>10.3f} "
-                f"{d['start_states']:>11.3f} {f'[{lo:.3f}, {hi:.3f}]':>19} "
-                f"{f'{min(redraws):.3f}..{max(redraws):.3f}':>21}"
+                f"{t:<22} {'yes' if p.observes_noise else 'no':>5} {_num(s['train']):>10} "
+                f"{_num(s['fresh_noise']):>10} {_num(s['test']):>10} {_num(d['noise']):>10} "
+                f"{_num(d['start_states']):>11} {f'[{_num(lo)}, {_num(hi)}]':>19} "
+                f"{f'{_num(min(redraws))}..{_num(max(redraws))}':>21}"
             )
         lines.append("")
     return lines[:-1]
+
+
+def _num(value: float) -> str:
+    """A score as the text tables print it: three decimals, "n/a" for a missing one (NaN)."""
+    return "n/a" if math.isnan(value) else f"{value:.3f}"
 
 
 def _interval(values: list[float]) -> tuple[float, float]:

@@ -9,8 +9,6 @@ in text and ``null`` in JSON. Examples: docs/api.md.
 
 from __future__ import annotations
 
-import csv
-import math
 import os
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -19,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from mtpg.api_config import preset
 from mtpg.api_evaluation import Evaluation, fmt, score_graph
+from mtpg.io.csvrows import read_rows
 
 if TYPE_CHECKING:
     from mtpg.config import RunConfig
@@ -389,25 +388,5 @@ def load(run_dir: PathLike) -> Run:
     def kept(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         return [r for r in rows if int(r["generation"]) <= committed]
 
-    metrics = kept(_read_csv(folder.metrics))
-    return Run(config, folder.path, metrics, kept(_read_csv(folder.path / TESTS_FILE, ("subset",))))
-
-
-def _read_csv(path: Path, text: tuple[str, ...] = ()) -> list[dict[str, Any]]:
-    """Rows of a run's CSV file, numbers parsed (empty cells NaN); none if it is missing."""
-    if not path.is_file():
-        return []
-    with open(path, encoding="utf-8", newline="") as fh:
-        return [
-            {k: v if k in text else _number(v) for k, v in row.items()}
-            for row in csv.DictReader(fh)
-        ]
-
-
-def _number(value: str) -> float | str:
-    if value == "":
-        return math.nan
-    try:
-        return float(value)
-    except ValueError:
-        return value
+    metrics = kept(read_rows(folder.metrics))
+    return Run(config, folder.path, metrics, kept(read_rows(folder.path / TESTS_FILE, ("subset",))))

@@ -1,4 +1,4 @@
-"""The tables of ``docs/robust-audit.md``, from the measurements of ``tools/robust_audit.py``.
+"""The tables of ``docs/robust-audit.md``, from the measurements of :mod:`.audit`.
 
 :func:`render` turns ``{run name: audit_run(...)}`` into the Markdown block the page holds
 between its markers; it computes nothing but formats.
@@ -6,7 +6,7 @@ between its markers; it computes nothing but formats.
 
 from __future__ import annotations
 
-from robust_audit import CLONE, CONFIRM_OFFSET, HOLD, TOP, UPRIGHT, WINDOW
+from mtpg.analysis.results.audit import CLONE, CONFIRM_OFFSET, HOLD, TOP, UPRIGHT, WINDOW
 
 
 def table_lines(head: list[str], rows: list[list[str]]) -> list[str]:

@@ -9,6 +9,7 @@ import pytest
 from mtpg.analysis.results import readme as results_readme
 from stopruns import mtpg
 from tinyruns import tiny_args
+from toolmodules import load_tool
 
 
 def _tiny_run(out, preset, seed, generations, *flags):
@@ -100,7 +101,7 @@ def test_summaries_leave_out_runs_still_growing_once_some_are_finished(
 
 
 def test_the_page_shows_the_recorded_resume_check(results, tmp_path):
-    import check_resume
+    check_resume = load_tool("check_resume")
 
     page = tmp_path / "results"
     shutil.copytree(results / "runs", page / "runs")

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from mtpg.analysis.results import audit as robust_audit
+from mtpg.analysis.results import audit_page
 from stopruns import mtpg
 from tinyruns import tiny_args
 
@@ -113,7 +114,7 @@ def test_write_puts_the_block_between_the_markers_and_keeps_the_prose(results, t
     doc.parent.mkdir()
     doc.write_text(f"# Title\n\nProse.\n\n{robust_audit.BEGIN}\nold\n{robust_audit.END}\n\nEnd.\n")
     out = tmp_path / "results"
-    written = robust_audit.write(results, out, episodes=5, oracle_episodes=3)
+    written = audit_page.write(results, out, episodes=5, oracle_episodes=3)
     assert written == doc
     text = doc.read_text()
     assert text.startswith("# Title\n\nProse.\n") and text.endswith("\n\nEnd.\n")

@@ -18,13 +18,11 @@ written by hand) and writes nothing into the runs. The definitions are the const
 from __future__ import annotations
 
 import csv
-import logging
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-_LOG = logging.getLogger(__name__)
 #: The page, in ``docs/`` beside the results folder, and the command its block names.
 PAGE = "robust-audit.md"
 COMMAND = ".venv/bin/mtpg report --results results --page robust-audit"
@@ -375,45 +373,3 @@ def write_doc(doc: Path, block: list[str]) -> None:
     head, rest = text.split(BEGIN, 1)
     tail = rest.split(END, 1)[1]
     doc.write_text(head + BEGIN + "\n" + "\n".join(block) + "\n" + END + tail, encoding="utf-8")
-
-
-def write(
-    results: Path,
-    out: Path | None = None,
-    prefix: str = "TPG-robust-seed",
-    episodes: int = 100,
-    oracle_episodes: int = 20,
-    threads: int = 1,
-) -> Path:
-    """Measures the runs and rewrites the block of ``docs/robust-audit.md``; its path.
-
-    Args:
-        results: The results folder (the page is ``docs/`` beside it).
-        out: The results folder written to (default: ``results``; the page goes to
-            ``docs/`` beside it).
-        prefix: Run folder names start with it.
-        episodes: Traced test episodes.
-        oracle_episodes: Episodes of (d).
-        threads: Numba threads.
-
-    Raises:
-        ValueError: No run folder starts with ``prefix``.
-    """
-    from mtpg.analysis.results.audit_page import render
-
-    runs = sorted((results / "runs").glob(prefix + "*"), key=lambda p: p.name)
-    if not runs:
-        raise ValueError(f"no run folder {prefix}* in {results / 'runs'}")
-    audits = {}
-    for run in runs:
-        audits[run.name] = audit_run(run, episodes, oracle_episodes, threads)
-        _LOG.info(f"{run.name}: done")
-    train = next(iter(audits.values()))["train_episodes"]
-    block = render(audits, COMMAND, episodes, oracle_episodes, train)
-    source = results.parent / "docs" / PAGE
-    page = (results if out is None else out).parent / "docs" / PAGE
-    page.parent.mkdir(parents=True, exist_ok=True)
-    if source != page and source.is_file():
-        page.write_text(source.read_text(encoding="utf-8"), encoding="utf-8")
-    write_doc(page, block)
-    return page

@@ -63,7 +63,7 @@ def _memorisation(results: Path, out: Path) -> Path:
 
 
 def _audit(results: Path, out: Path) -> Path:
-    from mtpg.analysis.results.audit import write
+    from mtpg.analysis.results.audit_page import write
 
     return write(results, out)
 

@@ -184,5 +184,6 @@ def write(results: Path, out: Path | None = None) -> Path:
     page = out.parent / "docs" / DOC
     page.parent.mkdir(parents=True, exist_ok=True)
     page.write_text(render((results.parent / "docs" / DOC).read_text(), scored))
+    (out.parent / "docs" / FIGURE).parent.mkdir(parents=True, exist_ok=True)
     figure(scored, out.parent / "docs" / FIGURE)
     return page

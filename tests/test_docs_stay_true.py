@@ -9,7 +9,7 @@ Every Markdown file of the project (README.md, CHANGELOG.md, docs/*.md, examples
 - counts that change with every commit (tests in the suite, lines of code) are not quoted;
 - a link's anchor names a heading of its page; examples import no ``mtpg.cli`` name;
 - figures quoted from the code (instruction set, subsets, bootstrap settings, seeds) are
-  the code's, and the README's results are those ``tools/results_readme.py`` wrote.
+  the code's, and the README's results are those ``mtpg report --results`` wrote.
 
 Other checked quotes live beside what they check: the presets table
 (``tests/test_presets_documented.py``) and the progress line of docs/report.md
@@ -194,7 +194,7 @@ def test_examples_import_only_what_is_public(doc):
 
 
 def test_the_results_summary_quotes_the_committed_results_as_results_readme_has_them():
-    """The paragraph's numbers (docs/results-summary.md) are those results_readme.py wrote."""
+    """The paragraph's numbers (docs/results-summary.md) are those the results page has."""
     summary = (ROOT / "docs" / "results-summary.md").read_text(encoding="utf-8")
     results = (ROOT / "results" / "README.md").read_text(encoding="utf-8")
     item = summary.split("- **The paper's experiment, in the repository**", 1)[1]
@@ -210,7 +210,7 @@ def test_the_results_summary_quotes_the_committed_results_as_results_readme_has_
 
 @pytest.mark.parametrize("doc", ["README.md", "docs/results-summary.md"])
 def test_the_readme_answers_does_it_reproduce_the_paper_as_the_results_page_does(doc):
-    """The README's answer is the page's, word for word (``tools/robust_section.answer``)."""
+    """The README's answer is the page's, word for word (``robust_section.answer`` writes it)."""
     readme = " ".join((ROOT / doc).read_text(encoding="utf-8").split())
     results = (ROOT / "results" / "README.md").read_text(encoding="utf-8")
     [answer] = [ln for ln in results.splitlines() if ln.startswith("**Does it reproduce")]

@@ -2,7 +2,7 @@
 
 The results page promises that ``mtpg train --resume results/runs/RUN`` continues any
 committed run exactly. The repository's history keeps the evidence to test that promise
-on the runs themselves: every commit of ``tools/grow_results.py`` holds a run's newest
+on the runs themselves: every commit of ``mtpg experiment --plan`` holds a run's newest
 checkpoint, and a later commit holds the generations that followed it. For each run::
 
     .venv/bin/python tools/check_resume.py [RUN ...] [--generations K]
@@ -20,7 +20,7 @@ repository, with the code checked out now, repeats them. Exit status 1 when any 
 
 With ``--record`` each run's outcome replaces its row of ``results/resume_check.csv``
 (run, the commit resumed from, generations, rows compared, result, the mtpg commit that
-checked, when), which ``tools/results_readme.py`` shows on the results page.
+checked, when), which ``mtpg report --results`` shows on the results page.
 """
 
 from __future__ import annotations

@@ -59,11 +59,13 @@ def test_module_imports_math_only_and_runs_without_site_packages(tmp_path):
     assert imported == {"math"}
     assert not any(isinstance(n, ast.ImportFrom) for n in ast.walk(tree))
     script = (
-        "import json, sys; sys.path.insert(0, sys.argv[1]); import champ; champ.reset(); "
+        "import json, sys, importlib.util as u; s = u.spec_from_file_location('champ', "
+        "sys.argv[1]); champ = u.module_from_spec(s); s.loader.exec_module(champ); "
+        "champ.reset(); "
         "print(json.dumps([(a, c.hex()) for a, c in map(champ.act, json.loads(sys.argv[2]))]))"
     )
     done = subprocess.run(
-        [sys.executable, "-I", "-S", "-c", script, str(tmp_path), json.dumps(stream.obs.tolist())],
+        [sys.executable, "-I", "-S", "-c", script, str(path), json.dumps(stream.obs.tolist())],
         capture_output=True,
         text=True,
         check=True,

@@ -24,12 +24,17 @@ def test_resume_from_an_earlier_commit_is_checked(tmp_path, monkeypatch, capsys)
     results.mkdir(parents=True)
     _git(repo, "init", "-q")
     _git(repo, "commit", "-q", "--allow-empty", "-m", "start")
-    grow = _tool("grow_results")
-    monkeypatch.setattr(grow, "PLAN", (("TPG-seed3", 3, None),))
-    argv = ["--budget", "5", "--unchecked", "--results", str(results)]
+    from mtpg.cli.main import main as mtpg_main
+
+    plan = tmp_path / "plan.toml"  # outside the repository, its folder inside
+    plan.write_text(
+        '[[groups]]\nname = "paper"\npreset = "paper"\nfolder = "repo/results"\n'
+        'generations = 1000\n[[groups.runs]]\nname = "TPG-seed{seed}"\nseeds = [3]\n'
+    )
+    argv = ["experiment", "--plan", str(plan), "--budget", "5", "--unchecked"]
     argv += [f"--train-arg={a}" for a in SETTINGS]
-    assert grow.main([*argv, "--generations", "5"]) == 0  # a commit at generation 5
-    assert grow.main([*argv, "--generations", "9"]) == 0  # and one at 9
+    assert mtpg_main([*argv, "--generations", "5"]) == 0  # a commit at generation 5
+    assert mtpg_main([*argv, "--generations", "9"]) == 0  # and one at 9
 
     check = _tool("check_resume")
     assert check.main(["--results", str(results), "--record"]) == 0

@@ -7,6 +7,8 @@
   traced replays, what they measure, task decomposition, Figs. 9-12, the page and videos.
 - :mod:`mtpg.analysis.description`: a graph's stable numbering, text listing, DOT and
   layout (``mtpg show``, and every picture of a graph).
+- :mod:`mtpg.analysis.results`: the committed results pages, written from the committed runs
+  (``mtpg report --results``).
 - Shared: :mod:`mtpg.analysis.html` (pages), :mod:`mtpg.analysis.plotting` (matplotlib),
   :mod:`mtpg.analysis.palette` (colours).
 

@@ -1,7 +1,8 @@
 """The TPG-robust section of ``results/README.md``: TPG-robust against TPG, seed by seed.
 
 TPG-robust is the ``robust`` preset (the ``paper`` preset with the training episodes
-redrawn every 10 generations; ``tools/grow_results.py --plan robust``), seeds 1 to 5,
+redrawn every 10 generations; ``mtpg experiment --plan results/plan.toml --only robust``),
+seeds 1 to 5,
 beside the TPG runs in ``results/runs``. :func:`section` writes its part of the page from
 the runs' files: both groups compared at one common test point (generation 1,000, with
 the TPG-robust runs that have reached it; before any has, the latest test point all
@@ -187,7 +188,7 @@ def _and(words: list[str]) -> str:
 
 def _per_task_verdict(c: Comparison) -> str:
     """TPG-robust's IQM per task against TPG's: "better in 5 tasks and level in X"."""
-    from results_text import LEVEL
+    from mtpg.analysis.results.tables import LEVEL
 
     ours, theirs = c.estimates["TPG-robust"][0], c.estimates["TPG"][0]
     kinds: dict[str, list[str]] = {"better": [], "level": [], "worse": []}
@@ -211,7 +212,7 @@ def answer(c: Comparison) -> list[str]:
     paper's rates in both counts (half the runs at 0.6 in all six, one in ten at 0.9);
     a task is better or worse when the IQMs differ by ``results_text.LEVEL`` or more.
     """
-    from results_text import PAPER
+    from mtpg.analysis.results.tables import PAPER
 
     n_tpg, n_rob = (len(c.groups[g]) for g in ("TPG", "TPG-robust"))
     tpg, rob = (c.estimates[g][1] for g in ("TPG", "TPG-robust"))
@@ -261,9 +262,12 @@ def section(c: Comparison, robust, probes: dict, target: int) -> list[str]:
             all-task champion (empty: no probe table).
         target: The generations every run grows to.
     """
-    from memorisation_doc import all_task_rows
-    from results_text import cpu_seconds_per_generation, engine_note, markdown_table
-
+    from mtpg.analysis.results.memorisation_page import all_task_rows
+    from mtpg.analysis.results.tables import (
+        cpu_seconds_per_generation,
+        engine_note,
+        markdown_table,
+    )
     from mtpg.analysis.runs import statistics as stats
     from mtpg.analysis.runs.statistics_figures import POI_NOTE, STATS_NOTE
 
@@ -278,7 +282,7 @@ def section(c: Comparison, robust, probes: dict, target: int) -> list[str]:
         "redrawn every 10 generations (`evaluation.resample_interval = 10`), within the "
         "paper's rules. It was chosen at `demo` scale over five seeds "
         "([candidates/README.md](candidates/README.md)) and runs at the paper's scale with "
-        "`tools/grow_results.py --plan robust`, seeds 1 to 5.",
+        "`mtpg experiment --plan results/plan.toml --only robust`, seeds 1 to 5.",
         "",
     ]
     growing = c.growing

@@ -1,4 +1,4 @@
-"""The tables of ``docs/robust-audit.md``, from the measurements of ``tools/robust_audit.py``.
+"""The tables of ``docs/robust-audit.md``, from the measurements of :mod:`.audit`, and the page.
 
 :func:`render` turns ``{run name: audit_run(...)}`` into the Markdown block the page holds
 between its markers; it computes nothing but formats.
@@ -6,7 +6,23 @@ between its markers; it computes nothing but formats.
 
 from __future__ import annotations
 
-from robust_audit import CLONE, CONFIRM_OFFSET, HOLD, TOP, UPRIGHT, WINDOW
+import logging
+from pathlib import Path
+
+from mtpg.analysis.results.audit import (
+    CLONE,
+    COMMAND,
+    CONFIRM_OFFSET,
+    HOLD,
+    PAGE,
+    TOP,
+    UPRIGHT,
+    WINDOW,
+    audit_run,
+    write_doc,
+)
+
+_LOG = logging.getLogger(__name__)
 
 
 def table_lines(head: list[str], rows: list[list[str]]) -> list[str]:
@@ -182,3 +198,43 @@ def render(
         + [""]
         + noise_table(audits, train)
     )
+
+
+def write(
+    results: Path,
+    out: Path | None = None,
+    prefix: str = "TPG-robust-seed",
+    episodes: int = 100,
+    oracle_episodes: int = 20,
+    threads: int = 1,
+) -> Path:
+    """Measures the runs and rewrites the block of ``docs/robust-audit.md``; its path.
+
+    Args:
+        results: The results folder (the page is ``docs/`` beside it).
+        out: The results folder written to (default: ``results``; the page goes to
+            ``docs/`` beside it).
+        prefix: Run folder names start with it.
+        episodes: Traced test episodes.
+        oracle_episodes: Episodes of (d).
+        threads: Numba threads.
+
+    Raises:
+        ValueError: No run folder starts with ``prefix``.
+    """
+    runs = sorted((results / "runs").glob(prefix + "*"), key=lambda p: p.name)
+    if not runs:
+        raise ValueError(f"no run folder {prefix}* in {results / 'runs'}")
+    audits = {}
+    for run in runs:
+        audits[run.name] = audit_run(run, episodes, oracle_episodes, threads)
+        _LOG.info(f"{run.name}: done")
+    train = next(iter(audits.values()))["train_episodes"]
+    block = render(audits, COMMAND, episodes, oracle_episodes, train)
+    source = results.parent / "docs" / PAGE
+    page = (results if out is None else out).parent / "docs" / PAGE
+    page.parent.mkdir(parents=True, exist_ok=True)
+    if source != page and source.is_file():
+        page.write_text(source.read_text(encoding="utf-8"), encoding="utf-8")
+    write_doc(page, block)
+    return page

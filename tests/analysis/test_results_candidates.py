@@ -1,10 +1,10 @@
-"""``tools/candidates_readme.py``: the candidates' table from per-run normalised scores."""
+"""``mtpg.analysis.results.candidates``: the candidates' table from per-run normalised scores."""
 
-from toolmodules import load_tool
+from mtpg.analysis.results import candidates
 
 
 def _tool():
-    return load_tool("candidates_readme")
+    return candidates
 
 
 def test_table_lists_every_run_and_compares_the_groups():

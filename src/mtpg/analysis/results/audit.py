@@ -2,7 +2,7 @@
 
 One command, from the repository root with the project's environment::
 
-    .venv/bin/python tools/robust_audit.py
+    .venv/bin/mtpg report --results results --page robust-audit
 
 For each run ``results/runs/TPG-robust-seed*`` at its final generation, deterministically,
 on the held-out episodes (:func:`mtpg.envs.taskset.episode_seeds.held_out_seeds`): (a) the
@@ -11,22 +11,21 @@ traced step by step (:func:`mtpg.engine.trace.trace_episode`); (b) slopes over t
 200 generations of ``metrics.csv`` and ``tests.csv``; (c) near-clones among the top 25
 roots of the checkpoint; (d) every root of the checkpoint on the lagging tasks; (e) the
 noise of a training score. It writes the tables between the markers of
-``docs/robust-audit.md`` (:mod:`robust_audit_page`; the prose around them is written by
-hand) and writes nothing into the runs. The definitions are the constants below.
+``docs/robust-audit.md`` (:mod:`~mtpg.analysis.results.audit_page`; the prose around them is
+written by hand) and writes nothing into the runs. The definitions are the constants below.
 """
 
 from __future__ import annotations
 
-import argparse
 import csv
-import shlex
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+#: The page, in ``docs/`` beside the results folder, and the command its block names.
+PAGE = "robust-audit.md"
+COMMAND = ".venv/bin/mtpg report --results results --page robust-audit"
 BEGIN, END = "<!-- audit:begin -->", "<!-- audit:end -->"
 #: Pendulum is *upright* when ``|wrapped theta| <= UPRIGHT`` rad (about 17 degrees).
 UPRIGHT = 0.3
@@ -374,43 +373,3 @@ def write_doc(doc: Path, block: list[str]) -> None:
     head, rest = text.split(BEGIN, 1)
     tail = rest.split(END, 1)[1]
     doc.write_text(head + BEGIN + "\n" + "\n".join(block) + "\n" + END + tail, encoding="utf-8")
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Measures the runs and writes the page's block."""
-    from robust_audit_page import render
-
-    argv = sys.argv[1:] if argv is None else argv
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--results", type=Path, default=ROOT / "results", help="results folder")
-    parser.add_argument(
-        "--prefix", default="TPG-robust-seed", help="run folder names start with it"
-    )
-    parser.add_argument(
-        "--doc", type=Path, default=ROOT / "docs" / "robust-audit.md", help="the page"
-    )
-    parser.add_argument("--episodes", type=int, default=100, help="traced test episodes (100)")
-    parser.add_argument("--oracle-episodes", type=int, default=20, help="episodes of (d) (20)")
-    parser.add_argument("--threads", type=int, default=1, help="Numba threads (1)")
-    args = parser.parse_args(argv)
-    runs = sorted((args.results / "runs").glob(args.prefix + "*"), key=lambda p: p.name)
-    if not runs:
-        print(f"error: no run folder {args.prefix}* in {args.results / 'runs'}", file=sys.stderr)
-        return 1
-    audits = {}
-    for run in runs:
-        audits[run.name] = audit_run(run, args.episodes, args.oracle_episodes, args.threads)
-        print(f"{run.name}: done", file=sys.stderr)
-    command = " ".join([".venv/bin/python tools/robust_audit.py", *map(shlex.quote, argv)])
-    train = next(iter(audits.values()))["train_episodes"]
-    block = render(audits, command, args.episodes, args.oracle_episodes, train)
-    write_doc(args.doc, block)
-    print("\n".join(block))
-    return 0
-
-
-if __name__ == "__main__":
-    from mtpg._kernel_cache import refresh
-
-    refresh()
-    sys.exit(main())

@@ -1,6 +1,7 @@
 """Score the demo-scale candidates of ``results/candidates`` and write their table.
 
-For every run of the demo plan (``tools/grow_results.py --plan demo``) that has reached
+For every run of the demo group (``mtpg experiment --plan results/plan.toml --only demo``)
+that has reached
 its last generation, the all-task champion is played on 100 held-out episodes per task
 (``mtpg evaluate RUN --episodes 100 --json``: seeds 1,000,000 to 1,000,099, never used by
 training or selection). The normalised scores (0 = random play, 1 = the reference best)
@@ -8,14 +9,15 @@ go to ``results/candidates/candidates.json``, and the README's section between t
 markers below gets the table: per run and task, then per group the interquartile mean
 over runs and tasks with its 95% stratified bootstrap interval, per task the IQM over
 runs, and the probability that a resampled run beats a plain one on a task, with its
-interval (:mod:`mtpg.analysis.runs.statistics`).
+interval (:mod:`mtpg.analysis.runs.statistics`)::
 
-    .venv/bin/python tools/candidates_readme.py
+    .venv/bin/mtpg report --results results --page candidates
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import subprocess
 import sys
 import tomllib
@@ -25,8 +27,9 @@ import numpy as np
 
 from mtpg.analysis.runs.statistics import aggregate_iqm, per_task_iqm, probability_of_improvement
 
-ROOT = Path(__file__).resolve().parent.parent
-FOLDER = ROOT / "results" / "candidates"
+_LOG = logging.getLogger(__name__)
+#: The study's folder inside the results folder.
+FOLDER = "candidates"
 GROUPS = {"demo": "demo-seed", "demo-resample10": "demo-resample10-seed"}
 EPISODES = 100
 BEGIN, END = "<!-- candidates table: begin -->", "<!-- candidates table: end -->"
@@ -75,29 +78,41 @@ def table(results: dict[str, dict[str, dict[str, float]]]) -> str:
     return "\n".join(lines)
 
 
-def main() -> int:
-    """Scores the finished runs and rewrites the README's table; returns the exit status."""
-    results: dict[str, dict[str, dict[str, float]]] = {}
-    for group, prefix in GROUPS.items():
-        runs = sorted(p for p in (FOLDER / "runs").glob(f"{prefix}[0-9]*") if p.is_dir())
-        results[group] = {r.name: scores(r) for r in runs if finished(r)}
-        print(f"{group}: {len(results[group])} of {len(runs)} runs finished", flush=True)
-    if not any(results.values()):
-        print("no finished run", file=sys.stderr)
-        return 1
-    (FOLDER / "candidates.json").write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
-    readme = FOLDER / "README.md"
-    text = readme.read_text()
-    head, _, rest = text.partition(BEGIN)
+def render(page: str, results: dict[str, dict[str, dict[str, float]]]) -> str:
+    """The README's text with the section between the markers written from ``results``."""
+    head, _, rest = page.partition(BEGIN)
     _, _, tail = rest.partition(END)
     body = (
         f"{BEGIN}\nNormalised scores on {EPISODES} held-out episodes per task of each finished "
-        "run's all-task champion (written by `tools/candidates_readme.py`):\n\n"
+        "run's all-task champion (written by "
+        "`mtpg report --results results --page candidates`):\n\n"
         f"{table(results)}\n{END}"
     )
-    readme.write_text(head + body + tail)
-    return 0
+    return head + body + tail
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+def write(results: Path, out: Path | None = None) -> Path:
+    """Scores the finished runs and rewrites the README's table; returns the README's path.
+
+    Args:
+        results: The results folder (its ``candidates/runs`` are scored, its
+            ``candidates/README.md`` is the page).
+        out: The results folder written to (default: ``results``).
+
+    Raises:
+        ValueError: No run has finished.
+    """
+    folder = results / FOLDER
+    scored: dict[str, dict[str, dict[str, float]]] = {}
+    for group, prefix in GROUPS.items():
+        runs = sorted(p for p in (folder / "runs").glob(f"{prefix}[0-9]*") if p.is_dir())
+        scored[group] = {r.name: scores(r) for r in runs if finished(r)}
+        _LOG.info(f"{group}: {len(scored[group])} of {len(runs)} runs finished")
+    if not any(scored.values()):
+        raise ValueError(f"{folder / 'runs'}: no finished run")
+    where = (results if out is None else out) / FOLDER
+    where.mkdir(parents=True, exist_ok=True)
+    (where / "candidates.json").write_text(json.dumps(scored, indent=1, sort_keys=True) + "\n")
+    readme = where / "README.md"
+    readme.write_text(render((folder / "README.md").read_text(), scored))
+    return readme

@@ -1,4 +1,4 @@
-"""Tables of ``results/README.md`` (used by ``tools/results_readme.py``).
+"""Tables of ``results/README.md`` (used by :mod:`mtpg.analysis.results.readme`).
 
 Each function turns the committed files of the runs (``metrics.csv``, ``tests.csv``,
 ``provenance.csv``, the checkpoint names) into a header and rows of strings; nothing here
@@ -22,8 +22,7 @@ PAPER = {
     "TPG-NoMemory": "well below 0.5 in every task",
     "TPG-NoHierarchy": "good only in MountainCarContinuous",
 }
-#: The repository (for git) and the commit that made the lane engine training's default.
-ROOT = Path(__file__).resolve().parents[1]
+#: The commit that made the lane engine training's default.
 LANE_ENGINE = "34fc1cf53f85672be4d76cb35f245edc1ad9ef62"
 #: Within this of the paper's figure counts as level.
 LEVEL = 0.05
@@ -298,8 +297,13 @@ def cpu_seconds_per_generation(paths: list[Path]) -> float:
     return sum(float(p["cpu_s"]) for p in rows) / gens if gens else float("nan")
 
 
-def on_lane_engine(commit: str, repo: Path = ROOT) -> bool | None:
-    """Whether an mtpg commit has the lane engine; None where git cannot tell."""
+def on_lane_engine(commit: str, repo: Path) -> bool | None:
+    """Whether an mtpg commit has the lane engine; None where git cannot tell.
+
+    Args:
+        commit: The commit.
+        repo: A folder inside the git work tree that knows it.
+    """
     try:
         done = subprocess.run(
             ["git", "-C", str(repo), "merge-base", "--is-ancestor", LANE_ENGINE, commit],
@@ -311,12 +315,15 @@ def on_lane_engine(commit: str, repo: Path = ROOT) -> bool | None:
     return {0: True, 1: False}.get(done.returncode)
 
 
-def engine_note(groups: dict[str, list[Path]], repo: Path = ROOT) -> str:
+def engine_note(groups: dict[str, list[Path]], repo: Path | None = None) -> str:
     """A sentence when the groups grew on different engines (empty when git cannot tell).
 
     The lane engine takes less CPU time than the engines before it, so a group grown with
-    it and one grown without are not compared like for like.
+    it and one grown without are not compared like for like. ``repo`` is a folder in the
+    git work tree (default: the first run's directory).
     """
+    if repo is None:
+        repo = next((p for paths in groups.values() for p in paths), Path("."))
     kinds = {}
     for label, paths in groups.items():
         commits = {p["mtpg_commit"] for path in paths for p in provenance(path)}

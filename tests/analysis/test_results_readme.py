@@ -1,17 +1,15 @@
-"""``tools/results_readme.py``: the results page and its figures, from run directories alone."""
+"""``mtpg.analysis.results.readme``: the results page and its figures, from run directories."""
 
 import re
 import shutil
-import sys
 from pathlib import Path
 
 import pytest
 
+from mtpg.analysis.results import readme as results_readme
 from stopruns import mtpg
 from tinyruns import tiny_args
-
-sys.path.insert(0, str(Path(__file__).parents[2] / "tools"))
-import results_readme
+from toolmodules import load_tool
 
 
 def _tiny_run(out, preset, seed, generations, *flags):
@@ -103,7 +101,7 @@ def test_summaries_leave_out_runs_still_growing_once_some_are_finished(
 
 
 def test_the_page_shows_the_recorded_resume_check(results, tmp_path):
-    import check_resume
+    check_resume = load_tool("check_resume")
 
     page = tmp_path / "results"
     shutil.copytree(results / "runs", page / "runs")
@@ -118,7 +116,7 @@ def test_the_page_shows_the_recorded_resume_check(results, tmp_path):
 
 
 def test_the_paper_s_ablation_claims_are_read_as_stated_rules():
-    from results_text import ablation_verdict
+    from mtpg.analysis.results.tables import ablation_verdict
 
     tasks = ("CartPole", "Pendulum", "MountainCarContinuous")
 
@@ -162,7 +160,7 @@ def test_tpg_robust_has_its_own_section_beside_the_paper_s_experiment(results, t
 
 
 def test_robust_section_helpers():
-    import robust_section as rs
+    from mtpg.analysis.results import robust_section as rs
 
     assert rs.seed_of("TPG-robust-seed12") == 12 and rs.is_robust(Path("x/TPG-robust-seed1"))
     assert not rs.is_robust(Path("TPG-seed1"))
@@ -183,7 +181,7 @@ def test_robust_section_helpers():
 def test_robust_runs_that_reached_the_target_are_compared_there():
     from types import SimpleNamespace as Run
 
-    import robust_section as rs
+    from mtpg.analysis.results import robust_section as rs
 
     done, mid, young = (
         Run(final_generation=1000),
@@ -201,7 +199,8 @@ def _comparison(tpg_scores, robust_scores, vs_scale=1.0):
     from types import SimpleNamespace as Run
 
     import numpy as np
-    import robust_section as rs
+
+    from mtpg.analysis.results import robust_section as rs
 
     tasks = ["A", "B", "C"]
     groups = {
@@ -225,7 +224,7 @@ def _comparison(tpg_scores, robust_scores, vs_scale=1.0):
 
 
 def test_the_answer_says_not_yet_until_the_paper_s_counts_are_met():
-    import robust_section as rs
+    from mtpg.analysis.results import robust_section as rs
 
     tpg = [[0.5, 0.4, 0.2]] * 4
     robust = [[0.95, 0.4, 0.7], [0.92, 0.3, 0.8], [0.99, 0.95, 0.65], [0.9, 0.5, 0.1]]
@@ -250,7 +249,7 @@ def test_the_answer_says_not_yet_until_the_paper_s_counts_are_met():
 def test_the_cost_is_cpu_time_per_generation_and_names_a_change_of_engine(tmp_path):
     import subprocess
 
-    import results_text as rt
+    from mtpg.analysis.results import tables as rt
 
     def commit(repo, message):
         git = ["git", "-C", str(repo), "-c", "user.name=t", "-c", "user.email=t@t"]

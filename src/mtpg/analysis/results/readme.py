@@ -2,31 +2,28 @@
 
 One command, from the repository root with the project's environment::
 
-    .venv/bin/python tools/results_readme.py
+    .venv/bin/mtpg report --results results --page results
 
-It reads ``results/runs/*`` (see ``tools/grow_results.py``), draws the section-5 figures
-with ``mtpg report`` into ``results/figures/``, the section-6 figures of the best run's
-all-task champion with ``mtpg analyze`` into ``results/analysis/``, and writes the README:
-status and cost of every run, the tables behind the figures, and the comparison with the
-paper task by task. Every number in the text is computed here from the runs' files, by the
-same library functions the report uses (:mod:`mtpg.analysis.runs.reported_numbers`,
-:mod:`mtpg.analysis.runs.statistics`).
+It reads ``results/runs/*`` (grown by ``mtpg experiment --plan results/plan.toml``),
+draws the section-5 figures with ``mtpg report`` into ``results/figures/``, the
+section-6 figures of the best run's all-task champion with ``mtpg analyze`` into
+``results/analysis/``, and writes the README: status and cost of every run, the tables
+behind the figures, and the comparison with the paper task by task. Every number in the
+text is computed here from the runs' files, by the same library functions the report
+uses (:mod:`mtpg.analysis.runs.reported_numbers`, :mod:`mtpg.analysis.runs.statistics`).
 """
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import subprocess
 import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
-
-sys.path.insert(0, str(Path(__file__).parent))
-from grow_results import KEEP_TESTS_EVERY
-from results_text import (  # the tool's own helper modules beside it
+from mtpg.analysis.results.robust_section import answer, compare, is_robust
+from mtpg.analysis.results.robust_section import section as robust_section
+from mtpg.analysis.results.tables import (
     GOOD,
     LEVEL,
     PAPER,
@@ -39,8 +36,7 @@ from results_text import (  # the tool's own helper modules beside it
     resume_check_rows,
     status_rows,
 )
-from robust_section import answer, compare, is_robust
-from robust_section import section as robust_section
+from mtpg.growing.tidy import KEEP_TESTS_EVERY
 
 TARGET = 1000
 GROWING = [
@@ -57,12 +53,13 @@ GROWING = [
     "",
     "```sh",
     "python3 -m venv .venv && .venv/bin/pip install -e .",
-    ".venv/bin/python tools/grow_results.py --budget 150   # minutes; commits every 40",
-    ".venv/bin/python tools/results_readme.py              # this page and its figures",
+    ".venv/bin/mtpg experiment --plan results/plan.toml --budget 150 --only paper  # minutes",
+    ".venv/bin/mtpg report --results results --page results  # this page and its figures",
     "git push",
     "```",
     "",
-    "`grow_results.py` continues the unfinished runs in order, two at a time with one "
+    "`mtpg experiment --plan` continues the unfinished runs of the plan's groups in "
+    "order, two at a time with one "
     "thread each, stops them with SIGTERM at a generation boundary every `--slice` minutes "
     "and when the budget is spent (or when it is itself stopped), keeps the newest "
     "checkpoint and commits `results/runs`. It refuses to run an mtpg whose `src/` has "
@@ -79,9 +76,18 @@ GROWING = [
 ]
 
 
+#: Runs of ``results/runs`` that are not on this page: TPG-authors (the ``authors`` group of
+#: ``results/plan.toml``) plays other tasks (the authors' interface), a study of its own.
+ELSEWHERE = ("TPG-authors-seed",)
+
+
 def _runs(results: Path) -> list[Path]:
     return sorted(
-        (p for p in (results / "runs").iterdir() if (p / "tests.csv").is_file()),
+        (
+            p
+            for p in (results / "runs").iterdir()
+            if (p / "tests.csv").is_file() and not p.name.startswith(ELSEWHERE)
+        ),
         key=lambda p: (not p.name.startswith("TPG-seed"), p.name),
     )
 
@@ -102,14 +108,17 @@ def _robust_figure(comparison, tpg, numbers, path: Path) -> Path:
     return aggregate(groups, drawn, comparison.estimates, path)
 
 
-def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
+def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | None = None) -> Path:
     """Writes the figures and ``README.md`` of ``results``; returns the README's path.
+
+    ``out`` is the folder they are written to (default: ``results`` itself; the page's
+    links are relative to it, so a copy elsewhere compares byte for byte).
 
     The TPG-robust runs (``TPG-robust-seedN``) are listed with the others (status,
     re-scores, cost) and compared with TPG in a section of their own
-    (:mod:`robust_section`); the paper's experiment (figures, summaries, ablations) is of
-    the other runs. ``probe`` adds the memorisation probe of every TPG and TPG-robust
-    final champion to that section.
+    (:mod:`~mtpg.analysis.results.robust_section`); the paper's experiment (figures,
+    summaries, ablations) is of the other runs. ``probe`` adds the memorisation probe of
+    every TPG and TPG-robust final champion to that section.
     """
     from mtpg.analysis.runs.champions import CHAMPION_RULE
     from mtpg.analysis.runs.loading import group_runs, load_run
@@ -140,7 +149,8 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
     if partial:
         tpg = dataclasses.replace(tpg, runs=finished)
     drawn = [p for p in paths if p in at_target] if partial else paths
-    figures = results / "figures"
+    out = results if out is None else out
+    figures = out / "figures"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         build_report(drawn, figures)
@@ -154,9 +164,11 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
         "",
         "Five runs of the `paper` preset (seeds 1 to 5) and one run of each ablation of "
         "section 5.2 (seed 1), each grown to 1,000 generations over several sittings with "
-        "`tools/grow_results.py` and committed with its last checkpoint, so that "
+        "`mtpg experiment --plan results/plan.toml` and committed with its last "
+        "checkpoint, so that "
         "`mtpg train --resume results/runs/RUN` continues any of them exactly. This page "
-        "and its figures are written by `.venv/bin/python tools/results_readme.py` from "
+        "and its figures are written by `.venv/bin/mtpg report --results results --page "
+        "results` from "
         "the committed files alone."
         + (
             " Beside them, five runs of TPG-robust (the `robust` preset), compared with "
@@ -283,15 +295,15 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
             lines.append(_fig(name, caption))
     lines += ["## Fig. 8: teams per decision by subset size", ""]
     lines += markdown_table(*hierarchy_rows(tpg.runs)) + [""]
+    analysis = out / "analysis"
     if analyze:
-        out = results / "analysis"
         subprocess.run(
-            [sys.executable, "-m", "mtpg", "analyze", str(best.run.path), "--out", str(out)],
+            [sys.executable, "-m", "mtpg", "analyze", str(best.run.path), "--out", str(analysis)],
             check=True,
             capture_output=True,
         )
-        (out / "index.html").unlink(missing_ok=True)
-    pngs = sorted((results / "analysis").glob("*.png")) if (results / "analysis").is_dir() else []
+        (analysis / "index.html").unlink(missing_ok=True)
+    pngs = sorted(analysis.glob("*.png")) if analysis.is_dir() else []
     if pngs:
         lines += [
             "## Section 6: inside the best champion (Figs. 9-12)",
@@ -340,7 +352,7 @@ def build(results: Path, analyze: bool = True, probe: bool = True) -> Path:
         ]
     if caught:
         lines += [f"Report warning: {w.message}" for w in caught] + [""]
-    readme = results / "README.md"
+    readme = out / "README.md"
     readme.write_text("\n".join(lines).rstrip() + "\n")
     return readme
 
@@ -350,22 +362,3 @@ def _vs(test: dict[str, float], best: dict[str, float], tasks) -> list[float]:
 
     v = normalise_scores(test, best)
     return [v[t] for t in tasks]
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Runs the command (see the module docstring)."""
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--results", type=Path, default=Path("results"), help="folder (results)")
-    p.add_argument("--no-analyze", action="store_true", help="skip the section-6 figures")
-    p.add_argument("--no-probe", action="store_true", help="skip TPG-robust's probe table")
-    args = p.parse_args(argv)
-    print(build(args.results, analyze=not args.no_analyze, probe=not args.no_probe))
-    return 0
-
-
-if __name__ == "__main__":
-    from mtpg._kernel_cache import refresh
-
-    refresh()  # before the first kernel: a Numba cache older than the sources goes
-    np.seterr(all="ignore")
-    sys.exit(main())

@@ -1,9 +1,12 @@
-"""``tools/grow_results.py``: runs grown in slices equal uninterrupted runs, and are committed."""
+"""``mtpg experiment --plan`` (and ``tools/grow_results.py``, which calls it): runs grown in
+slices equal uninterrupted runs, and are committed."""
 
 import csv
 import subprocess
 import tarfile
 
+from mtpg.cli.main import main as mtpg_main
+from mtpg.growing.plan import load_plan
 from mtpg.io.checkpoint import load_checkpoint
 from stopruns import SETTINGS, mtpg, without_timing
 from tinyruns import tiny_args
@@ -16,6 +19,16 @@ SLOW = tiny_args("CartPole,MountainCar", root_size=200, n_elite=40, evaluation__
 
 def _tool():
     return load_tool("grow_results")
+
+
+def _plan(folder, *runs):
+    """A plan file in ``folder``: one group ``paper`` of ``(name, seed, args)`` runs."""
+    text = '[[groups]]\nname = "paper"\npreset = "paper"\nfolder = "."\ngenerations = 1000\n'
+    for name, seed, args in runs:
+        text += f'[[groups.runs]]\nname = "{name}"\nseeds = [{seed}]\n'
+        text += f"args = {list(args)!r}\n".replace("'", '"')
+    (folder / "plan.toml").write_text(text)
+    return folder / "plan.toml"
 
 
 def _git(repo, *args):
@@ -36,22 +49,23 @@ def _repo(tmp_path, monkeypatch):
 
 def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypatch):
     repo = _repo(tmp_path, monkeypatch)
-    tool = _tool()
-    monkeypatch.setattr(
-        tool, "PLAN", (("TPG-seed3", 3, None), ("TPG-NoMemory-seed3", 3, "no-memory"))
+    plan = _plan(
+        repo / "results", ("TPG-seed{seed}", 3, []), ("TPG-NoMemory-seed{seed}", 3, ["--no-memory"])
     )
-    monkeypatch.setattr(tool, "KEEP_TESTS_EVERY", 8)
-    argv = ["--budget", "5", "--unchecked", "--results", str(repo / "results")]
+    _git(repo, "add", "results/plan.toml")
+    _git(repo, "commit", "-q", "-m", "the plan")
+    monkeypatch.setattr("mtpg.growing.tidy.KEEP_TESTS_EVERY", 8)
+    argv = ["experiment", "--plan", str(plan), "--budget", "5", "--unchecked"]
     argv += [f"--train-arg={a}" for a in SETTINGS]
     # two sittings, the second one in slices of about 2 seconds
-    assert tool.main([*argv, "--generations", "10"]) == 0
-    assert tool.main([*argv, "--generations", str(GENERATIONS), "--slice", "0.04"]) == 0
+    assert mtpg_main([*argv, "--generations", "10"]) == 0
+    assert mtpg_main([*argv, "--generations", str(GENERATIONS), "--slice", "0.04"]) == 0
 
-    for name, seed, flag in tool.PLAN:
+    for run in load_plan(plan).groups[0].runs():
+        name, seed = run.name, run.seed
         grown = repo / "results" / "runs" / name
         ref = tmp_path / name
-        extra = [f"--{flag}"] if flag else []
-        args = ["train", "--preset", "paper", "--seed", str(seed), *extra, *SETTINGS]
+        args = ["train", "--preset", "paper", "--seed", str(seed), *run.train_args, *SETTINGS]
         assert mtpg(*args, "--generations", str(GENERATIONS), "--out", str(ref)).returncode == 0
         for table in ("metrics.csv", "tests.csv"):
             assert without_timing((grown / table).read_text()) == without_timing(
@@ -97,61 +111,20 @@ def test_slices_of_a_grown_run_add_up_to_an_uninterrupted_run(tmp_path, monkeypa
     assert ".lock" not in tracked and ".log" not in tracked
 
 
-def test_the_demo_plan_starts_demo_runs_with_and_without_resampling(tmp_path, monkeypatch):
-    tool = _tool()
-    started = []
-
-    class FakePopen:
-        def __init__(self, cmd, **_kw):
-            started.append(cmd)
-
-    monkeypatch.setattr(tool.subprocess, "Popen", FakePopen)
-    (tmp_path / "runs").mkdir()
-    args = tool.argparse.Namespace(
-        results=tmp_path, generations=1000, workers=1, train_arg=[], python="py", plan="demo"
-    )
-    for name, seed, variant in tool.DEMO_PLAN:
-        tool.start(name, seed, variant, args)
-    assert len(started) == 10 and {c[c.index("--seed") + 1] for c in started} == set("12345")
-    assert all(c[c.index("--preset") + 1] == "demo" for c in started)
-    resampled = [c for c in started if "evaluation.resample_interval=10" in c]
-    assert len(resampled) == 5
-    assert all("resample10" in c[c.index("--out") + 1] for c in resampled)
-
-
-def test_the_authors_plan_starts_paper_runs_with_the_authors_interface(tmp_path, monkeypatch):
-    tool = _tool()
-    started = []
-
-    class FakePopen:
-        def __init__(self, cmd, **_kw):
-            started.append(cmd)
-
-    monkeypatch.setattr(tool.subprocess, "Popen", FakePopen)
-    (tmp_path / "runs").mkdir()
-    args = tool.argparse.Namespace(
-        results=tmp_path, generations=1000, workers=1, train_arg=[], python="py", plan="authors"
-    )
-    for name, seed, variant in tool.plan_runs("authors"):
-        tool.start(name, seed, variant, args)
-    assert len(started) == 5 and {c[c.index("--seed") + 1] for c in started} == set("12345")
-    assert all(c[c.index("--preset") + 1] == "paper" for c in started)
-    tasks = {c[c.index("--tasks") + 1] for c in started}
-    assert tasks == {",".join(tool.AUTHORS_TASKS.values())}
-    assert all("TPG-authors-seed" in c[c.index("--out") + 1] for c in started)
-
-
 def test_the_last_run_left_takes_the_threads_of_the_runs_that_finished(
     tmp_path, monkeypatch, capsys
 ):
+    """Through ``tools/grow_results.py``, whose flags keep their meaning."""
     repo = _repo(tmp_path, monkeypatch)
     tool = _tool()
-    near, far = ("TPG-seed3", 3, None), ("TPG-seed4", 4, None)
+    near = ("TPG-seed{seed}", 3, [])  # then seeds 3 and 4
     argv = ["--budget", "5", "--unchecked", "--results", str(repo / "results")]
-    monkeypatch.setattr(tool, "PLAN", (near,))
+    monkeypatch.setattr(tool, "PLAN_FILE", _plan(tmp_path, near))
     near_args = [f"--train-arg={a}" for a in SETTINGS]
     assert tool.main([*argv, *near_args, "--generations", "16"]) == 0
-    monkeypatch.setattr(tool, "PLAN", (near, far))
+    (tmp_path / "plan.toml").write_text(
+        (tmp_path / "plan.toml").read_text().replace("seeds = [3]", "seeds = [3, 4]")
+    )
     capsys.readouterr()
     # the run begun now is slower, so that it is still running when the other ends
     far_args = [f"--train-arg={a}" for a in SLOW]

@@ -1,16 +1,12 @@
-"""``tools/robust_audit.py``: the audit of issue 52 item 3, on a tiny run trained here."""
-
-import sys
-from pathlib import Path
+"""``mtpg.analysis.results.audit``: the audit of issue 52 item 3, on a tiny run trained here."""
 
 import numpy as np
 import pytest
 
+from mtpg.analysis.results import audit as robust_audit
+from mtpg.analysis.results import audit_page
 from stopruns import mtpg
 from tinyruns import tiny_args
-
-sys.path.insert(0, str(Path(__file__).parents[2] / "tools"))
-import robust_audit
 
 TASKS = "CartPole,CartCentering,Pendulum"
 
@@ -113,23 +109,16 @@ def test_a_balanced_and_a_spinning_pendulum():
     assert modes["ret_balanced"] == -0.5 and modes["ret_lost"] == -450.0
 
 
-def test_main_writes_the_block_between_the_markers_and_keeps_the_prose(results, tmp_path):
-    doc = tmp_path / "audit.md"
+def test_write_puts_the_block_between_the_markers_and_keeps_the_prose(results, tmp_path):
+    doc = tmp_path / "docs" / "robust-audit.md"
+    doc.parent.mkdir()
     doc.write_text(f"# Title\n\nProse.\n\n{robust_audit.BEGIN}\nold\n{robust_audit.END}\n\nEnd.\n")
-    argv = [
-        "--results",
-        str(results),
-        "--doc",
-        str(doc),
-        "--episodes",
-        "5",
-        "--oracle-episodes",
-        "3",
-    ]
-    assert robust_audit.main(argv) == 0
+    out = tmp_path / "results"
+    written = audit_page.write(results, out, episodes=5, oracle_episodes=3)
+    assert written == doc
     text = doc.read_text()
     assert text.startswith("# Title\n\nProse.\n") and text.endswith("\n\nEnd.\n")
     assert "old" not in text and "| TPG-robust-seed1 |" in text
-    assert "tools/robust_audit.py --results" in text
+    assert "mtpg report --results results --page robust-audit" in text
     for part in ("(a)", "(b)", "(c)", "(d)", "(e)"):
         assert f"### {part}" in text

@@ -3,7 +3,7 @@
 The study (issue 40, item 3) asks how much of the paper's result the observation
 interface of the authors' published code could explain: CartCentering + MountainCar and
 the six tasks, each with the paper's interface and with the code's
-(``tools/grow_results.py``: :data:`AUTHORS_TASKS`), ``demo`` preset, seeds 1 to 3, 1,000
+(``results/plan.toml``: ``[interfaces.authors]``), ``demo`` preset, seeds 1 to 3, 1,000
 generations. The six tasks with the paper's interface are the candidates' runs
 ``results/candidates/runs/demo-seed1..3`` (the same preset and seeds).
 
@@ -15,20 +15,20 @@ signature of CartCentering played as MountainCar. The figures go to
 ``results/variants/variants.json``, the table between the markers of
 ``docs/variants-study.md``, the figure to ``docs/img/variants-study.png``::
 
-    .venv/bin/python tools/variants_study.py
+    .venv/bin/mtpg report --results results --page variants
 """
 
 from __future__ import annotations
 
 import json
-import sys
+import logging
 from pathlib import Path
 
 import numpy as np
-from candidates_readme import EPISODES, finished
-from candidates_readme import scores as run_scores
 
 from mtpg.analysis.plotting import pyplot, save
+from mtpg.analysis.results.candidates import EPISODES, finished
+from mtpg.analysis.results.candidates import scores as run_scores
 from mtpg.analysis.runs.champions import run_champion
 from mtpg.analysis.runs.statistics import aggregate_iqm, per_task_iqm
 from mtpg.engine.batch import Episodes
@@ -38,16 +38,17 @@ from mtpg.envs.taskset.episode_seeds import held_out_seeds
 from mtpg.io.runconfig import read_run_config
 from mtpg.io.serialize import load_graph
 
-ROOT = Path(__file__).resolve().parent.parent
-FOLDER = ROOT / "results" / "variants"
-DOC = ROOT / "docs" / "variants-study.md"
-FIGURE = ROOT / "docs" / "img" / "variants-study.png"
-#: Each group: its label and where its runs are (folder, name prefix).
+_LOG = logging.getLogger(__name__)
+#: The study's folder inside the results folder; its page and figure inside ``docs/``.
+FOLDER = "variants"
+DOC = "variants-study.md"
+FIGURE = "img/variants-study.png"
+#: Each group: its label and where its runs are in the results folder (folder, prefix).
 GROUPS = {
-    "CC+MC, paper": (FOLDER / "runs", "ccmc-paper-seed"),
-    "CC+MC, authors' code": (FOLDER / "runs", "ccmc-authors-seed"),
-    "six tasks, paper": (ROOT / "results" / "candidates" / "runs", "demo-seed"),
-    "six tasks, authors' code": (FOLDER / "runs", "six-authors-seed"),
+    "CC+MC, paper": ("variants/runs", "ccmc-paper-seed"),
+    "CC+MC, authors' code": ("variants/runs", "ccmc-authors-seed"),
+    "six tasks, paper": ("candidates/runs", "demo-seed"),
+    "six tasks, authors' code": ("variants/runs", "six-authors-seed"),
 }
 SEEDS = (1, 2, 3)
 BEGIN, END = "<!-- variants table: begin -->", "<!-- variants table: end -->"
@@ -77,17 +78,17 @@ def off_track(run: Path) -> tuple[float, float]:
     return left / EPISODES, (from_left / left if left else float("nan"))
 
 
-def collect() -> dict[str, dict[str, dict]]:
+def collect(results: Path) -> dict[str, dict[str, dict]]:
     """Every finished run's scores and CartCentering behaviour, by group."""
     out: dict[str, dict[str, dict]] = {}
     for group, (folder, prefix) in GROUPS.items():
         out[group] = {}
         for s in SEEDS:
-            run = folder / f"{prefix}{s}"
+            run = results / folder / f"{prefix}{s}"
             if finished(run):
                 share, left = off_track(run)
                 out[group][run.name] = {"scores": scores(run), "off_track": share, "left": left}
-        print(f"{group}: {len(out[group])} of {len(SEEDS)} runs finished", flush=True)
+        _LOG.info(f"{group}: {len(out[group])} of {len(SEEDS)} runs finished")
     return out
 
 
@@ -121,7 +122,7 @@ COLOURS = {
 }
 
 
-def figure(results: dict[str, dict[str, dict]]) -> None:
+def figure(results: dict[str, dict[str, dict]], path: Path) -> None:
     """Per task IQM over runs (bars, 95% intervals), and CartCentering's episodes off track."""
     plt = pyplot()
     fig, (ax, off) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [5, 1.3]})
@@ -153,31 +154,36 @@ def figure(results: dict[str, dict[str, dict]]) -> None:
     off.set_title("CartCentering off the track", fontsize=10)
     fig.suptitle("The paper's interface and the authors' code's (demo, 1,000 generations)")
     fig.tight_layout()
-    save(fig, FIGURE)
+    save(fig, path)
 
 
-def main() -> int:
-    """Scores the finished runs, rewrites the doc's table and the figure."""
-    stored = FOLDER / "variants.json"
-    if "--figure-only" in sys.argv[1:]:
-        figure(json.loads(stored.read_text()))
-        return 0
-    results = collect()
-    if not any(results.values()):
-        print("no finished run", file=sys.stderr)
-        return 1
-    FOLDER.mkdir(parents=True, exist_ok=True)
-    (FOLDER / "variants.json").write_text(json.dumps(results, indent=1, sort_keys=True) + "\n")
-    text = DOC.read_text()
-    head, _, rest = text.partition(BEGIN)
+def render(page: str, results: dict[str, dict[str, dict]]) -> str:
+    """The page's text with the section between the markers written from ``results``."""
+    head, _, rest = page.partition(BEGIN)
     _, _, tail = rest.partition(END)
-    DOC.write_text(f"{head}{BEGIN}\n{table(results)}\n{END}{tail}")
-    figure(results)
-    return 0
+    return f"{head}{BEGIN}\n{table(results)}\n{END}{tail}"
 
 
-if __name__ == "__main__":
-    from mtpg._kernel_cache import refresh
+def write(results: Path, out: Path | None = None) -> Path:
+    """Scores the finished runs, rewrites the page's table and the figure; the page's path.
 
-    refresh()  # before the first kernel: a Numba cache older than the sources goes
-    raise SystemExit(main())
+    Args:
+        results: The results folder (the page is ``docs/`` beside it).
+        out: The results folder written to (default: ``results``; the page and the
+            figure go to ``docs/`` beside it).
+
+    Raises:
+        ValueError: No run has finished.
+    """
+    scored = collect(results)
+    if not any(scored.values()):
+        raise ValueError(f"{results}: no finished run of the interface study")
+    out = results if out is None else out
+    (out / FOLDER).mkdir(parents=True, exist_ok=True)
+    (out / FOLDER / "variants.json").write_text(json.dumps(scored, indent=1, sort_keys=True) + "\n")
+    page = out.parent / "docs" / DOC
+    page.parent.mkdir(parents=True, exist_ok=True)
+    page.write_text(render((results.parent / "docs" / DOC).read_text(), scored))
+    (out.parent / "docs" / FIGURE).parent.mkdir(parents=True, exist_ok=True)
+    figure(scored, out.parent / "docs" / FIGURE)
+    return page

@@ -165,3 +165,20 @@ def test_the_decomposition_goes_to_a_task_with_a_hidden_state():
     assert default_decompose_task([CARTPOLE, "Acrobot"]) == "Acrobot"
     assert default_decompose_task([CARTPOLE, "Acrobot", "Pendulum"]) == "Pendulum"
     assert default_decompose_task([CARTPOLE]) is None
+
+
+def test_envs_lists_gymnasium_tasks_by_name_or_from_a_run(runs, capsys):
+    assert main(["envs", "--tasks", f"{CARTPOLE},CartPole"]) == 0
+    out = capsys.readouterr().out
+    assert "4 inputs: 2 linear, 2 tanh" in out and "Discrete(2): 0 + a_d mod 2" in out
+    assert "s[1] [-inf, inf]: tanh" in out and "s[0] [-4.8, 4.8]: linear" in out
+    assert "no best given: scores are raw" in out
+    row = next(x for x in out.splitlines() if x.startswith("0 "))
+    assert "CartPole" in row and "195" in row  # a registered task's row as the default's
+    assert main(["envs", "--run", str(runs[1])]) == 0
+    out = capsys.readouterr().out
+    assert LINE_TASK in out and "1 inputs: 1 linear, 0 tanh" in out and "  15  " in out
+    assert main(["envs", "--tasks", CARTPOLE, "--run", str(runs[1])]) == 2
+    one_error_line(capsys.readouterr().err, "envs")
+    assert main(["envs", "--tasks", "gym:nomod:X-v0"]) == 2
+    assert "module 'nomod' does not import" in one_error_line(capsys.readouterr().err, "envs")

@@ -37,7 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.graph.page import build_analysis
+    from mtpg.analysis.graph.page import HIDDEN_STATE_NOTE, build_analysis, not_applicable
     from mtpg.cli.common import resolve_graph, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
@@ -55,6 +55,8 @@ def run(args: argparse.Namespace) -> int:
             raise UsageError(f"unknown task {t!r}; choose from {', '.join(TASK_NAMES)}")
     if args.decompose_task and args.decompose_task not in tasks:
         raise UsageError(f"--decompose-task {args.decompose_task} is not among {tasks}")
+    if args.decompose_task in not_applicable(tasks):
+        raise UsageError(f"--decompose-task {args.decompose_task}: {HIDDEN_STATE_NOTE}")
     no_memory, memory_text = resolve_no_memory(args.memory, meta)
     if args.out:
         out = Path(args.out)
@@ -66,6 +68,8 @@ def run(args: argparse.Namespace) -> int:
         f"{target}: root team {root}; {args.episodes} test episodes per task of "
         f"{', '.join(tasks)} (seed offset {args.seed}); {memory_text}"
     )
+    for task, note in not_applicable(tasks).items():
+        print(f"  {task}: {note}")
     files = build_analysis(
         pop,
         root,

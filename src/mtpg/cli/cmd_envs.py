@@ -1,4 +1,9 @@
-"""``mtpg envs``: the six tasks with their interface, time limits and reference scores."""
+"""``mtpg envs``: the six tasks with their interface, time limits and reference scores.
+
+With ``--tasks`` or ``--run``, the tasks named (or a run's) instead, Gymnasium tasks
+included: their interface as mtpg reads it (observation size and scaling, the action
+mapping), time limit and random-play score measured by mtpg.
+"""
 
 from __future__ import annotations
 
@@ -18,9 +23,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
             "Lists the six partially-observable tasks: observed inputs, the action each "
             "reads, time limit, random-agent mean, reference best, solved threshold and the "
             "source of the best. With --measure, re-measures the random-agent means and the "
-            "CartCentering time-optimal score and prints them next to the stored figures."
+            "CartCentering time-optimal score and prints them next to the stored figures. "
+            "With --tasks or --run, lists those tasks instead, Gymnasium tasks (gym:ID) "
+            "included: observation size and scaling, action mapping, time limit and the "
+            "random-play score mtpg measures."
         ),
     )
+    parser.add_argument(
+        "--tasks",
+        help="comma-separated tasks to list, registered or Gymnasium (gym:CartPole-v1)",
+    )
+    parser.add_argument("--run", metavar="DIR", help="list the tasks of this run directory")
     parser.add_argument(
         "--measure",
         action="store_true",
@@ -44,6 +57,10 @@ def run(args: argparse.Namespace) -> int:
     Returns:
         Exit code 0.
     """
+    if args.tasks is not None or args.run is not None:
+        from mtpg.cli.envs_listing import list_tasks
+
+        return list_tasks(args)
     from mtpg.envs.specs.contract import CARTCENTERING, TASK_NAMES
     from mtpg.envs.specs.param_table import ACTION_USED, MAX_STEPS, OBSERVED
     from mtpg.envs.taskset.reference_scores import (

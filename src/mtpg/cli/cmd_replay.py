@@ -62,6 +62,13 @@ def run(args: argparse.Namespace) -> int:
     pop, root, meta, _ = resolve_graph(Path(args.target))
     no_memory, memory_text = resolve_no_memory(args.memory, meta)
     table = target_task_table(Path(args.target), [args.task])
+    gym_task = table.spec(args.task) if table.is_gym(table.id_of(args.task)) else None
+    if args.video and gym_task is not None:
+        from mtpg.analysis.graph.gym_replay import render_refusal
+
+        refusal = render_refusal(gym_task)
+        if refusal:  # before the replay: nothing is written
+            raise UsageError(refusal)
     replay = replay_task(pop, root, args.task, args.episodes, args.seed, no_memory, table=table)
     returns = replay["returns"]
     lengths = np.diff(replay["episode_offsets"])
@@ -82,8 +89,18 @@ def run(args: argparse.Namespace) -> int:
         from mtpg.analysis.description.layout import layout_graph
         from mtpg.analysis.graph.video import write_video
 
+        images = None
+        if gym_task is not None:  # the environment's own frames, the episode played again
+            from mtpg.analysis.graph.gym_replay import gym_frames
+
+            images = gym_frames(gym_task, replay, 0, args.max_frames)
         frames = write_video(
-            replay, layout_graph(pop, root), args.video, fps=args.fps, max_frames=args.max_frames
+            replay,
+            layout_graph(pop, root),
+            args.video,
+            fps=args.fps,
+            max_frames=args.max_frames,
+            frames=images,
         )
         print(f"wrote {args.video} ({frames} frames)")
     return 0

@@ -28,7 +28,9 @@ def run(args: argparse.Namespace) -> int:
     from mtpg.cli.common import resolve_graph
 
     target = Path(args.target)
-    pop, root, meta, _ = resolve_graph(target)
+    pop, root, meta, tasks = resolve_graph(target)
+    if target.is_dir():  # a run's champion file does not hold the run's tasks; show them
+        meta = {"tasks": tasks, **meta}
     print(f"{target}: root team {root}")
     print(describe_graph(pop, root, meta))
     if args.dot:

@@ -10,6 +10,14 @@ each batch one task that runs the serial compiled kernel of
 loads the kernels once, on its first task), and the outcomes are put back in job order.
 Results are bit-identical to the local backend's.
 
+Gymnasium tasks (:mod:`mtpg.envs.specs.gym_task`) step in Python: a table holding them
+sends the compiled population itself and each batch runs
+:func:`~mtpg.engine.batch.run_jobs` on its worker (:func:`play_mixed_batch`), which makes
+the batch's environments there. So every worker must import what the task names: the
+``gymnasium`` package, and for ``gym:module:Env-v0`` the user's module (on the workers'
+``PYTHONPATH``, or installed); a worker that cannot is an error of one line naming the
+module.
+
 Faults. A worker that dies mid-evaluation costs time only: Dask recomputes its batches on
 the other workers (evaluation is pure); should every copy of the inputs die with workers,
 the evaluation is sent again (up to :data:`RESUBMITS` times). A lost scheduler (or a batch
@@ -29,7 +37,7 @@ import warnings
 
 import numpy as np
 
-from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots
+from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots, run_jobs
 from mtpg.engine.compile import CompiledPopulation, Graph
 from mtpg.engine.evaluator import BackendError, BackendLost
 from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_queue
@@ -105,6 +113,29 @@ def play_batch(
     # one queue block: the batch's jobs in lane blocks of consecutive jobs (a root's episodes)
     run_lanes_queue(queue, max(len(job_roots), 1), DEFAULT_LANES, jobs, table, out, graph)
     return out
+
+
+def play_mixed_batch(
+    cp: CompiledPopulation, job_roots: np.ndarray, job_eps: np.ndarray, table: Episodes
+) -> BatchResult:
+    """Plays one batch of a table with Gymnasium tasks (runs on a worker).
+
+    Its environments are made on the worker; :func:`~mtpg.engine.batch.run_jobs` plays
+    them as on this machine, so results are the local backend's.
+
+    Raises:
+        GymTaskError: One line, saying it happened on a worker (and, for a module that
+            does not import there, what the workers need).
+    """
+    from mtpg.envs.specs.gym_task import GymTaskError
+
+    try:
+        return run_jobs(cp, job_roots, job_eps, table, 1, block=max(len(table.tasks), 1))
+    except GymTaskError as exc:
+        hint = ""
+        if "does not import" in str(exc):
+            hint = "; every dask worker must import it (on its PYTHONPATH, or installed)"
+        raise GymTaskError(f"on dask worker (pid {os.getpid()}): {exc}{hint}") from None
 
 
 def warm_up() -> int:
@@ -282,7 +313,9 @@ class DaskEvaluator:
     def _map(self, cp, roots, episodes) -> list:
         n_ep = len(episodes.tasks)
         n_batches = plan_batches(len(roots), self.threads, self.min_roots)
-        [graph] = self.client.scatter([graph_arrays(cp)], broadcast=True, hash=False)
+        # Gymnasium tasks step in Python on the workers: they take the population itself
+        play, code = (play_mixed_batch, cp) if episodes.gym else (play_batch, graph_arrays(cp))
+        [graph] = self.client.scatter([code], broadcast=True, hash=False)
         table = self._table(episodes)
         episode_rows = np.arange(n_ep, dtype=np.int64)
         futures = []
@@ -290,7 +323,7 @@ class DaskEvaluator:
             batch = roots[b::n_batches]
             futures.append(
                 self.client.submit(
-                    play_batch,
+                    play,
                     graph,
                     np.repeat(batch, n_ep),
                     np.tile(episode_rows, len(batch)),

@@ -456,7 +456,7 @@ def _digest(text: str, n: int) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:n]
 
 
-def _file_safe(task: str) -> str:
+def file_safe(task: str) -> str:
     """A task name as a file name may hold it.
 
     A ``gym:`` or compiled (``module:ATTR``) name's colons, slashes and quotes become ``_``
@@ -476,7 +476,7 @@ def champion_filename(task_names: tuple[str, ...]) -> str:
     subset as ``6-tasks-HASH.json``; the file's ``tasks`` entry names the subset in full
     (:func:`read_champions` reads it back).
     """
-    tasks = tuple(_file_safe(t) for t in canonical_tasks(task_names))
+    tasks = tuple(file_safe(t) for t in canonical_tasks(task_names))
     full = "+".join(tasks) + ".json"
     if len(full.encode()) <= MAX_FILENAME:
         return full

@@ -46,7 +46,13 @@ def describe_graph(pop: Population, root: int, meta: dict | None = None) -> str:
         f"{n_instr} instructions ({n_eff} effective, {n_instr - n_eff} introns)",
         "numbers: team N is the N-th team in depth-first order from the root (team 1); "
         "bank N likewise by first use",
+        f"interface: {layout.n_obs} observed input{'s' * (layout.n_obs != 1)} "
+        f"s[0..{layout.n_obs - 1}], {layout.n_actions} atomic "
+        f"action{'s' * (layout.n_actions != 1)} 0..{layout.n_actions - 1}",
     ]
+    tasks = (meta or {}).get("tasks")
+    if isinstance(tasks, list) and tasks:
+        lines.append("meta tasks: " + ", ".join(map(str, tasks)))
     for key, value in sorted((meta or {}).items()):
         if isinstance(value, str | int | float | bool):
             lines.append(f"meta {key}: {value}")

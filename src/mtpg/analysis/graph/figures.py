@@ -85,11 +85,16 @@ def register_access(access: dict, path: Path, title: str) -> Path:
     return save(fig, path)
 
 
-def time_series(task: str, series: dict, prediction: dict, path: Path, title: str) -> Path:
-    """Figs. 11-12: complexity, memory window and velocity prediction of one episode."""
+def time_series(task: str, series: dict, prediction: dict | None, path: Path, title: str) -> Path:
+    """Figs. 11-12: complexity, memory window and velocity prediction of one episode.
+
+    ``prediction`` None (a task whose hidden state mtpg does not see, a Gymnasium task):
+    the three panels without the velocity.
+    """
     plt = pyplot()
     colour = task_colour(task)
-    fig, axes = plt.subplots(4, 1, figsize=(7.5, 8.2), sharex=True)
+    rows = 3 if prediction is None else 4
+    fig, axes = plt.subplots(rows, 1, figsize=(7.5, 2.05 * rows), sharex=True)
     steps = series["step"]
     axes[0].step(steps, series["teams"], where="mid", color=colour, lw=1.2)
     axes[0].set_ylabel("teams visited")
@@ -122,7 +127,17 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
             0.5, 0.5, "no written memory value read", ha="center", transform=axes[2].transAxes
         )
     axes[2].set_ylabel("memory window\n(age of values read,\nsteps)")
-    ax = axes[3]
+    if prediction is not None:
+        _velocity_panel(axes[3], prediction, colour)
+    axes[-1].set_xlabel("time step")
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return save(fig, path)
+
+
+def _velocity_panel(ax, prediction: dict, colour: str) -> None:
+    """The bottom panel of :func:`time_series`: the velocity and the closest register."""
+    steps = prediction["step"]
     ax.plot(steps, prediction["velocity"], color="black", lw=1.2, label=prediction["variable"])
     if prediction["label"]:
         r = prediction["r"]
@@ -153,10 +168,6 @@ def time_series(task: str, series: dict, prediction: dict, path: Path, title: st
             transform=ax.transAxes,
         )
     ax.legend(fontsize=7, loc="upper left", ncol=2)
-    ax.set_xlabel("time step")
-    fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
-    return save(fig, path)
 
 
 def decomposition(dec: dict, numbers: list[int], path: Path, title: str) -> Path:

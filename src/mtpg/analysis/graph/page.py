@@ -29,13 +29,31 @@ from mtpg.analysis.runs.hierarchical_complexity import (
     mean_by_size,
     run_complexity,
 )
+from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.taskset.task_table import TaskTable
+from mtpg.io.rundir import file_safe
 from mtpg.model.graph import Population
 
+#: Why a Gymnasium task gets no velocity panel and no decomposition (one line).
+HIDDEN_STATE_NOTE = (
+    "no velocity prediction (Figs. 11-12 bottom) or task decomposition (Fig. 10): they "
+    "need the task's hidden velocity, and a Gymnasium environment keeps its state to itself"
+)
 
-def default_decompose_task(tasks: list[str]) -> str:
-    """Pendulum when analysed (the paper's Fig. 10a), else the first task."""
-    return "Pendulum" if "Pendulum" in tasks else tasks[0]
+
+def default_decompose_task(tasks: list[str]) -> str | None:
+    """Pendulum when analysed (the paper's Fig. 10a), else the first task with a hidden state.
+
+    None when every task is a Gymnasium task (:data:`HIDDEN_STATE_NOTE`).
+    """
+    if "Pendulum" in tasks:
+        return "Pendulum"
+    return next((t for t in tasks if not is_gym(t)), None)
+
+
+def not_applicable(tasks: list[str]) -> dict[str, str]:
+    """The analyses skipped for some of ``tasks``, one line per task, by task."""
+    return {t: HIDDEN_STATE_NOTE for t in tasks if is_gym(t)}
 
 
 def median_episode(returns: np.ndarray) -> int:
@@ -93,14 +111,17 @@ def build_analysis(
         Written files by name (``index`` is the HTML page).
     """
     decompose_task = decompose_task or default_decompose_task(tasks)
-    if decompose_task not in tasks:
+    if decompose_task is not None and decompose_task not in tasks:
         raise ValueError(f"--decompose-task {decompose_task!r} is not among the tasks analysed")
+    if decompose_task is not None and is_gym(decompose_task):
+        raise ValueError(f"--decompose-task {decompose_task}: {HIDDEN_STATE_NOTE}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     a = _Analysis(pop, root, tasks, out, episodes, seed, no_memory, label)
     a.graph_figures()
     summary = a.task_figures()
-    a.decomposition_figure(decompose_task)
+    if decompose_task is not None:
+        a.decomposition_figure(decompose_task)
     if run_dir is not None:
         a.run_figure(Path(run_dir))
     a.write_dot()
@@ -170,8 +191,8 @@ class _Analysis:
         one = replay_task(
             self.pop, self.root, task, 1, self.seed + typical, self.no_memory, table=self.table
         )
-        pred = velocity_prediction(one, 0)
-        name = f"timeseries_{task}.png"
+        pred = None if is_gym(task) else velocity_prediction(one, 0)
+        name = f"timeseries_{file_safe(task)}.png"
         title = (
             f"{task}: the test episode of median return\n(seed {int(one['episode_seeds'][0])}, "
             f"return {one['returns'][0]:.2f}, {one.n_steps} steps)"
@@ -179,6 +200,8 @@ class _Analysis:
         path = figures.time_series(task, step_series(one, 0), pred, self.out / name, title)
         self._add(name, path, f"{task}: run-time dynamics (Figs. 11-12)")
         rates = visits["rate"][:, self.tasks.index(task)]
+        if pred is None:
+            pred = {"label": None, "r": float("nan"), "variable": None}
         return {
             "mean_return": float(np.mean(replays[task]["returns"])),
             "mean_teams_per_step": float(replays[task].counts("visit").mean()),
@@ -189,6 +212,7 @@ class _Analysis:
             "visit_rate": {
                 f"team {n}": float(v) for n, v in zip(visits["teams"], rates, strict=True)
             },
+            **({"not_applicable": HIDDEN_STATE_NOTE} if is_gym(task) else {}),
         }
 
     def decomposition_figure(self, task: str) -> None:
@@ -222,9 +246,13 @@ class _Analysis:
             f"<tr><td>{html.escape(t)}</td><td>{s['mean_return']:.3f}</td>"
             f"<td>{s['mean_teams_per_step']:.2f}</td>"
             f"<td>{s['mean_instructions_per_step']:.1f}</td>"
-            f"<td>{html.escape(str(s['best_register']))}</td>"
+            f"<td>{html.escape(str(s['best_register'] or '-'))}</td>"
             f"<td>{'' if s['pearson_r'] is None else format(s['pearson_r'], '.2f')}</td></tr>"
             for t, s in summary["tasks"].items()
+        )
+        skipped = "".join(
+            f"<p>{html.escape(t)}: {html.escape(n)}.</p>"
+            for t, n in not_applicable(self.tasks).items()
         )
         body = f"""<h1>Inside {label}</h1>
 <p>{self.n_teams} teams; {self.episodes} test episodes per task (seed offset {self.seed}); \
@@ -233,6 +261,7 @@ Team numbers: team 1 is the root, the others in depth-first order (as in <code>m
 </p>
 <table><tr><th>task</th><th>mean return</th><th>teams/step</th><th>instructions/step</th>
 <th>register tracking the velocity</th><th>Pearson r</th></tr>{rows}</table>
+{skipped}
 {_visit_table(self.visits)}
 {"".join(self.sections)}"""
         return pages.page(f"mtpg analyze: {self.label}", body)

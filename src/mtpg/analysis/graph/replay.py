@@ -47,6 +47,10 @@ mem_age                (A,)        steps since the value read (or overwritten) w
 mem_from_reset         (A,)        True when the value had not been written in the episode
                                    (it is the reset 0)
 =====================  ==========  ===========================================================
+
+A Gymnasium task's replay (:mod:`mtpg.analysis.graph.gym_replay`) has every key; its
+``observation`` is ``(N, n_obs)``, ``hidden_state`` and ``final_state`` have no columns, and
+it adds ``raw_observation``, ``env_action_d`` and ``env_action_c``.
 """
 
 from __future__ import annotations
@@ -187,6 +191,11 @@ def replay_task(
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     table = TaskTable.from_names([task]) if table is None else table
     task_id = table.id_of(task)
+    if table.is_gym(task_id):  # the environment steps in Python: traced from Python
+        from mtpg.analysis.graph.gym_replay import replay_gym_task
+
+        spec = table.spec(task_id)
+        return replay_gym_task(pop, root, spec, task_id, episodes, seed, no_memory, memory_episodes)
     # the tracer logs programs as stated (unfolded); the ablation is the compiled graph's
     cp = compile_population(pop, fold_constants=False, no_memory=no_memory)
     seeds = held_out_seeds(episodes, seed)

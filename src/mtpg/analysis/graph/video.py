@@ -53,6 +53,7 @@ def write_video(
     fps: int = 25,
     max_frames: int | None = None,
     dpi: int = 72,
+    frames: list | None = None,
 ) -> int:
     """Writes one episode of a replay as a GIF or MP4 video.
 
@@ -64,6 +65,9 @@ def write_video(
         fps: Frames per second.
         max_frames: Stop after this many frames (None: the whole episode).
         dpi: Resolution of the frames.
+        frames: The task's images, one per step of the episode from its first (a
+            Gymnasium task's own, :func:`~mtpg.analysis.graph.gym_replay.gym_frames`);
+            None: drawn from the replay's hidden states by mtpg's renderer.
 
     Returns:
         The number of frames written (the episode length, unless ``max_frames`` cuts it).
@@ -79,7 +83,7 @@ def write_video(
     steps = range(sl.start, sl.stop if max_frames is None else min(sl.stop, sl.start + max_frames))
     # frames are drawn off-screen: no display is needed (and SDL stays quiet without one)
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    renderer = make_renderer(task_spec(replay.task))
+    renderer = None if frames is not None else make_renderer(task_spec(replay.task))
     task = replay.task
     fig, (ax_task, ax_graph) = plt.subplots(
         1, 2, figsize=(9, 4), gridspec_kw={"width_ratios": [1.3, 1]}
@@ -93,8 +97,11 @@ def write_video(
     try:
         with writer.saving(fig, str(path), dpi):
             for i in steps:
-                prev = replay["a_c"][i - 1] if i > sl.start else 0.0
-                frame = renderer.frame(replay["hidden_state"][i], float(prev))
+                if renderer is None:
+                    frame = frames[i - sl.start]
+                else:
+                    prev = replay["a_c"][i - 1] if i > sl.start else 0.0
+                    frame = renderer.frame(replay["hidden_state"][i], float(prev))
                 if image is None:
                     image = ax_task.imshow(frame)
                     ax_task.set_xticks([])
@@ -114,6 +121,7 @@ def write_video(
                 writer.grab_frame()
                 count += 1
     finally:
-        renderer.close()
+        if renderer is not None:
+            renderer.close()
         plt.close(fig)
     return count

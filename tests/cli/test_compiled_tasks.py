@@ -73,14 +73,14 @@ def user_module(tmp_path, monkeypatch):
     return env
 
 
-def mtpg(env, *args):
+def call(env, *args):
     return subprocess.run(
         [sys.executable, "-m", "mtpg", *args], env=env, capture_output=True, text=True
     )
 
 
 def run(env, *args):
-    done = mtpg(env, *args)
+    done = call(env, *args)
     assert done.returncode == 0, done.stderr
     return done.stdout
 
@@ -167,6 +167,16 @@ def test_a_compiled_task_trains_resumes_exactly_and_acts_as_a_policy(tmp_path, u
     probe = run(user_module, "probe", str(whole))
     assert " n/a " in probe and "nan" not in probe  # raw scores: no normalised ones
     run(user_module, "show", str(whole))
+    trace = ["replay", str(whole), "--task", TASK, "--episodes", "1"]
+    refused = call(user_module, *trace, "--out", str(tmp_path / "r.npz"))
+    assert refused.returncode != 0 and "Traceback" not in refused.stderr
+    assert (
+        refused.stderr.strip()
+        .splitlines()[-1]
+        .startswith(
+            "mtpg replay: error: tracing a compiled task of a user's module is not supported yet"
+        )
+    )
 
 
 BAD = {
@@ -224,7 +234,7 @@ def test_a_bad_compiled_task_is_refused_in_one_line(tmp_path, user_module, name)
     folder = Path(user_module["PYTHONPATH"].split(os.pathsep)[0])
     (folder / "userbad.py").write_text(module)
     out = tmp_path / "run"
-    done = mtpg(
+    done = call(
         user_module, "train", *SMALL, "--tasks", name, "--generations", "2", "--out", str(out)
     )
     assert done.returncode != 0

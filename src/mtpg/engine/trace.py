@@ -29,6 +29,7 @@ from mtpg.engine.record import (
     record_decision,
     record_observation,
 )
+from mtpg.envs.taskset.task_table import GYM_ID_BASE, USER_ID_BASE
 
 
 @njit(cache=True, error_model="numpy")
@@ -170,6 +171,11 @@ def trace_episode(
     bool overrides it.
     """
     _check_unfolded(cp)
+    if USER_ID_BASE <= task < GYM_ID_BASE:  # its state and dispatch are not the tracer's
+        raise ValueError(
+            "tracing a compiled task of a user's module is not supported yet "
+            "(replay and analyze need the registered tasks or a gym: task)"
+        )
     g = cp.with_memory_mode(no_memory).graph
     root = cp.team_index(root_id)
     table = Episodes.single(task, start, noise, obs_noise, params)

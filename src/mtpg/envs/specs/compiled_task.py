@@ -145,6 +145,12 @@ class CompiledTask:
         return caps if 2 <= len(caps) <= 4 else self.title[:3]
 
     @property
+    def observed(self) -> str:
+        """The observation, as text (``mtpg envs``)."""
+        noise = ", with the noise input" if self.noise_input else ""
+        return f"{self.n_obs} inputs written by {self.observe.__name__}{noise}"
+
+    @property
     def action_text(self) -> str:
         """The action, as text."""
         parts = [f"a_d in 0..{self.n_actions - 1}"] if self.n_actions else []

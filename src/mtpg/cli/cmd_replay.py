@@ -17,7 +17,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "the tracing engine: per step the hidden state, observation, actions, reward, teams "
         "visited, instructions executed, memory reads and writes with the age of each value "
         "read, and every memory register (schema: docs/analysis.md). --video renders the "
-        "task beside the graph with the decision path highlighted.",
+        "task beside the graph with the decision path highlighted. A Gymnasium task (gym:ID) "
+        "has no hidden state in the trace (the environment keeps it) and its video frames are "
+        "the environment's own rgb_array render; one that cannot render is refused.",
     )
     p.add_argument("target", metavar="GRAPH_OR_RUN", help="a graph .json file or a run directory")
     p.add_argument("--task", required=True, help="task name")

@@ -128,14 +128,14 @@ def time_series(task: str, series: dict, prediction: dict | None, path: Path, ti
         )
     axes[2].set_ylabel("memory window\n(age of values read,\nsteps)")
     if prediction is not None:
-        _velocity_panel(axes[3], prediction, colour, steps)
+        _velocity_panel(axes[3], steps, prediction, colour)
     axes[-1].set_xlabel("time step")
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     return save(fig, path)
 
 
-def _velocity_panel(ax, prediction: dict, colour: str, steps: np.ndarray) -> None:
+def _velocity_panel(ax, steps: np.ndarray, prediction: dict, colour: str) -> None:
     """The bottom panel of :func:`time_series`: the velocity and the closest register."""
     ax.plot(steps, prediction["velocity"], color="black", lw=1.2, label=prediction["variable"])
     if prediction["label"]:

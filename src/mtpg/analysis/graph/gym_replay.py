@@ -22,59 +22,49 @@ playing the episode's recorded actions again from the same reset seed
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from mtpg.analysis.graph.replay import Replay, _assemble
-from mtpg.engine.compile import compile_population
-from mtpg.engine.live_trace import trace_gym_episode
+from mtpg.engine.compile import CompiledPopulation
+from mtpg.engine.live_trace import GymTrace, trace_gym_episode
 from mtpg.envs.specs.gym_task import GymTask, GymTaskError, _make
-from mtpg.envs.taskset.episode_seeds import held_out_seeds
-from mtpg.model.graph import Population
+
+if TYPE_CHECKING:  # replay.py imports this module: the type only, no cycle
+    from mtpg.analysis.graph.replay import Replay
 
 #: The render mode frames are taken in.
 RENDER_MODE = "rgb_array"
 
 
-def replay_gym_task(
-    pop: Population,
-    root: int,
-    task: GymTask,
-    task_id: int,
-    episodes: int,
-    seed: int,
-    no_memory: bool,
-    memory_episodes: int | None,
-) -> Replay:
-    """Plays and traces test episodes of a Gymnasium task (see the module docstring).
+def trace_gym_episodes(
+    cp: CompiledPopulation, root: int, task: GymTask, seeds: np.ndarray, n_mem_eps: int
+) -> list[GymTrace]:
+    """Plays and traces the episodes of ``seeds`` (reset seeds) of a Gymnasium task.
 
     Args:
-        pop: The population holding the graph.
+        cp: Compiled unfolded, in the memory mode to replay.
         root: Root team id.
         task: The task.
-        task_id: Its id in the run's task table.
-        episodes: Test episodes.
-        seed: Test seed offset.
-        no_memory: Memory off (the TPG-NoMemory semantics).
-        memory_episodes: Record every memory register for this many leading episodes.
+        seeds: The episodes' reset seeds (the held-out seeds of ``mtpg evaluate``).
+        n_mem_eps: Record every memory register for this many leading episodes.
 
     Raises:
         GymTaskError: One line, for an environment that fails or leaves its bounds.
     """
-    cp = compile_population(pop, fold_constants=False, no_memory=no_memory)
-    seeds = held_out_seeds(episodes, seed)
-    n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
-    played = [
+    return [
         trace_gym_episode(cp, root, task, int(s), snapshot=e < n_mem_eps)
         for e, s in enumerate(seeds)
     ]
-    header = {"task": task.name, "task_id": task_id, "seed": seed, "episode_seeds": seeds}
-    replay = _assemble(pop, root, cp, [p.trace for p in played], header, no_memory, n_mem_eps)
-    data = dict(replay.data)
-    data["raw_observation"] = np.concatenate([p.raw_observations for p in played])
-    data["env_action_d"] = np.concatenate([p.env_actions_d for p in played])
-    data["env_action_c"] = np.concatenate([p.env_actions_c for p in played])
-    return Replay(data)
+
+
+def gym_keys(played: list[GymTrace]) -> dict[str, np.ndarray]:
+    """The keys a Gymnasium task's replay adds (see the module docstring)."""
+    return {
+        "raw_observation": np.concatenate([p.raw_observations for p in played]),
+        "env_action_d": np.concatenate([p.env_actions_d for p in played]),
+        "env_action_c": np.concatenate([p.env_actions_c for p in played]),
+    }
 
 
 def render_refusal(task: GymTask) -> str | None:

@@ -62,6 +62,7 @@ from pathlib import Path
 import numpy as np
 
 from mtpg.analysis.description.numbering import effective_instruction_map, index_graph
+from mtpg.analysis.graph.gym_replay import gym_keys, trace_gym_episodes
 from mtpg.engine.compile import CompiledPopulation, compile_population
 from mtpg.engine.trace import Trace, trace_episode, trace_sequence
 from mtpg.envs.taskset.episode_seeds import held_out_seeds
@@ -191,16 +192,16 @@ def replay_task(
         raise ValueError(f"episodes must be >= 1, got {episodes}")
     table = TaskTable.from_names([task]) if table is None else table
     task_id = table.id_of(task)
-    if table.is_gym(task_id):  # the environment steps in Python: traced from Python
-        from mtpg.analysis.graph.gym_replay import replay_gym_task
-
-        spec = table.spec(task_id)
-        return replay_gym_task(pop, root, spec, task_id, episodes, seed, no_memory, memory_episodes)
     # the tracer logs programs as stated (unfolded); the ablation is the compiled graph's
     cp = compile_population(pop, fold_constants=False, no_memory=no_memory)
     seeds = held_out_seeds(episodes, seed)
-    starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds, table)
     n_mem_eps = episodes if memory_episodes is None else min(episodes, memory_episodes)
+    header = {"task": task, "task_id": task_id, "seed": seed, "episode_seeds": seeds}
+    if table.is_gym(task_id):  # the environment steps in Python: traced from Python
+        played = trace_gym_episodes(cp, root, table.spec(task_id), seeds, n_mem_eps)
+        replay = _assemble(pop, root, cp, [p.trace for p in played], header, no_memory, n_mem_eps)
+        return Replay({**replay.data, **gym_keys(played)})
+    starts, noise, obs_noise = draw_episodes(np.full(episodes, task_id), seeds, table)
     traces = [
         trace_episode(
             cp,
@@ -214,7 +215,6 @@ def replay_task(
         )
         for e in range(episodes)
     ]
-    header = {"task": task, "task_id": task_id, "seed": seed, "episode_seeds": seeds}
     return _assemble(pop, root, cp, traces, header, no_memory, n_mem_eps)
 
 

@@ -168,28 +168,25 @@ def reference_of(task: int | str, table: TaskTable = REGISTERED) -> Reference:
 
 
 def gym_reference(task: GymTask, given: GivenReference | None) -> Reference:
-    """A Gymnasium task's reference scores: random play measured (or given), best given.
-
-    Without a given best, ``best`` is NaN: its scores are reported raw, not normalised.
-    """
-    if given is not None and given.random is not None:
-        random, how = (given.random, NONE), "random given"
-    else:
-        random, how = measure_gym_random(task.name), "random measured"
-    if given is None:
-        return Reference(*random, NONE, NONE, f"{how}; no best given: scores are raw")
-    return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")
+    """A Gymnasium task's reference scores (:func:`raw_or_given`)."""
+    return raw_or_given(given, lambda: measure_gym_random(task.name))
 
 
 def compiled_reference(task: CompiledTask, given: GivenReference | None) -> Reference:
-    """A compiled task's reference scores: random play measured (or given), best given.
+    """A compiled task's reference scores (:func:`raw_or_given`)."""
+    return raw_or_given(given, lambda: measure_compiled_random(task.name))
 
-    Without a given best, ``best`` is NaN: its scores are reported raw, not normalised.
+
+def raw_or_given(given: GivenReference | None, measure) -> Reference:
+    """Reference scores of a task with no registered best: random play measured, best given.
+
+    ``measure()`` gives the random agent's (mean, std) unless ``given`` holds a random
+    score. Without a given best, ``best`` is NaN: scores are reported raw, not normalised.
     """
     if given is not None and given.random is not None:
         random, how = (given.random, NONE), "random given"
     else:
-        random, how = measure_compiled_random(task.name), "random measured"
+        random, how = measure(), "random measured"
     if given is None:
         return Reference(*random, NONE, NONE, f"{how}; no best given: scores are raw")
     return Reference(*random, given.best, NONE, f"{how}; best given: {given.source}")

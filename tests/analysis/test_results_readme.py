@@ -281,3 +281,58 @@ def test_the_cost_is_cpu_time_per_generation_and_names_a_change_of_engine(tmp_pa
         assert rt.engine_note({"X": [runs["a"]]}, tmp_path) == ""  # no git here: unsaid
     finally:
         rt.LANE_ENGINE = rt_lane
+
+
+def test_tpg_authors_joins_tpg_and_tpg_robust_in_a_three_group_section(results, tmp_path):
+    folder = tmp_path / "results"
+    shutil.copytree(results / "runs", folder / "runs")
+    _tiny_run(folder / "runs" / "TPG-robust-seed1", "robust", 1, 2)
+    settings = tiny_args(
+        "CartPole,MountainCar[noise_high=pi;noise_low=-pi;obs_high=1;obs_low=0]",
+        root_size=16, n_elite=2, evaluation__test_interval=2,
+    )  # fmt: skip
+    done = mtpg(
+        "train", "--preset", "paper", "--seed", "1", *settings, "--set",
+        "evaluation.test_episodes=5", "--generations", "2",
+        "--out", str(folder / "runs" / "TPG-authors-seed1"),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    text = results_readme.build(folder, analyze=False, probe=True).read_text()
+    section = text[text.index("## The three groups") : text.index("## Cost")]
+    assert "**In progress**: 1 of 5 TPG-authors runs begun, 1 at generation 2" in section
+    # the variant's columns by its base name, normalised on one scale with the others
+    assert "| run | generation | CartPole | MountainCar | worst task | mean |" in section
+    assert "| TPG-authors (1 run) |" in section and "| TPG-robust (1 run) |" in section
+    assert "P(TPG-authors > TPG) = " in section and "P(TPG-authors > TPG-robust) = " in section
+    assert "| claim (paper) | TPG: its text |" in section
+    assert "| TPG-authors-seed1 | 2 | " in section  # re-scores and the probe
+    assert "| TPG-authors-seed1 | TPG-authors | 1 | 2 of 1000 (growing) |" in text
+    # the paper's experiment's re-score table keeps to the runs of its tasks
+    assert "TPG-authors-seed1 | 2 | " not in text[: text.index("## The three groups")]
+
+
+def test_the_authors_sentence_and_the_verdict_on_the_paper_s_claims():
+    from types import SimpleNamespace as Run
+
+    import numpy as np
+
+    from mtpg.analysis.results import authors_section as au
+
+    runs = [Run(name=f"TPG-authors-seed{i}") for i in (1, 2)]
+    norm = {"TPG-authors-seed1": {"A": 0.9, "B": 0.7}, "TPG-authors-seed2": {"A": 1.0, "B": 0.5}}
+    a = au.Authors(runs, runs, 1000, norm, norm, np.array([[0.9, 0.7], [1.0, 0.5]]))
+    assert not a.complete and a.count(0.6) == 1 and a.count(0.9) == 0
+    assert a.best.name == "TPG-authors-seed1"  # the higher worst task
+    text = au.answer_sentence(a)
+    assert "(TPG-authors, 2 of 5 runs at generation 1,000 so far)" in text
+    assert "1 of 2 runs reaches 0.6 and 0 reach 0.9 of the group's own" in text
+    rows = [
+        ["x (5 of 10)", "0 of 5: does not hold", "3 of 5: holds", "1 of 2: holds"],
+        ["y (1 of 10)", "0 of 5: does not hold", "0 of 5: does not hold", "1 of 2: holds"],
+        ["z", "0 of 6: does not hold", "0 of 6: does not hold", "0 of 6: does not hold"],
+    ]
+    assert au.verdict(rows) == (
+        "X: hold with the paper's text (TPG or TPG-robust). Y: hold only with its code's "
+        "interface (TPG-authors). Z: hold with neither."
+    )
+    assert au.base("Pendulum[max_steps=300]") == "Pendulum"

@@ -21,6 +21,8 @@ import sys
 import warnings
 from pathlib import Path
 
+from mtpg.analysis.results.authors_section import answer_sentence, gather, is_authors
+from mtpg.analysis.results.authors_section import section as authors_section
 from mtpg.analysis.results.robust_section import answer, compare, is_robust
 from mtpg.analysis.results.robust_section import section as robust_section
 from mtpg.analysis.results.tables import (
@@ -76,18 +78,9 @@ GROWING = [
 ]
 
 
-#: Runs of ``results/runs`` that are not on this page: TPG-authors (the ``authors`` group of
-#: ``results/plan.toml``) plays other tasks (the authors' interface), a study of its own.
-ELSEWHERE = ("TPG-authors-seed",)
-
-
 def _runs(results: Path) -> list[Path]:
     return sorted(
-        (
-            p
-            for p in (results / "runs").iterdir()
-            if (p / "tests.csv").is_file() and not p.name.startswith(ELSEWHERE)
-        ),
+        (p for p in (results / "runs").iterdir() if (p / "tests.csv").is_file()),
         key=lambda p: (not p.name.startswith("TPG-seed"), p.name),
     )
 
@@ -133,8 +126,9 @@ def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | N
 
     every = [load_run(p) for p in _runs(results)]
     robust = [dataclasses.replace(r, label="TPG-robust") for r in every if is_robust(r.path)]
-    every = [r for r in every if not is_robust(r.path)] + robust  # TPG-robust listed last
-    runs = [r for r in every if not is_robust(r.path)]  # the paper's experiment
+    authors = [dataclasses.replace(r, label="TPG-authors") for r in every if is_authors(r.path)]
+    runs = [r for r in every if not is_robust(r.path) and not is_authors(r.path)]
+    every = runs + robust + authors  # the paper's experiment, then TPG-robust, TPG-authors
     paths = [r.path for r in runs]
     groups, _ = group_runs(runs)
     numbers = {r.path: run_numbers(r) for r in runs}
@@ -175,12 +169,22 @@ def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | N
             "TPG in their own section below."
             if robust
             else ""
+        )
+        + (
+            " TPG-authors (the `paper` preset on the interface of the authors' published "
+            "code) joins both in the section after it."
+            if authors
+            else ""
         ),
         "",
     ]
     comparison = compare(tpg.runs, robust, best_single, TARGET) if robust else None
+    three = gather(authors, list(tasks), TARGET) if authors and comparison else None
     if comparison is not None and comparison.complete:
-        lines += [*answer(comparison), ""]
+        said = answer(comparison)
+        if three is not None:
+            said[-1] += " " + answer_sentence(three)
+        lines += [*said, ""]
     lines += ["## Status", ""]
     done = len(at_target) == len(runs)
     if done and any(r.final_generation < TARGET for r in robust):
@@ -240,7 +244,7 @@ def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | N
     rows.append([f"IQM over TPG seeds{at}", "", *(e.text(2) for e in per_task)])
     lines += markdown_table(head, rows)
     lines += ["", f"IQM over TPG seeds{at} and all tasks: {overall.text(2)}.", ""]
-    head, rows, agree, cells = rescore_rows(every)
+    head, rows, agree, cells = rescore_rows(runs + robust)  # TPG-authors: its own tasks
     lines += [
         "Every run's all-task champion: mean test return ± the half-width of its 95% "
         f"confidence interval (1.96 std / sqrt(n), n = {runs[0].test_episodes} test "
@@ -324,6 +328,13 @@ def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | N
         if comparison.complete:
             _robust_figure(comparison, tpg, numbers, figures / "robust_vs_tpg.png")
             lines.append(_fig("robust_vs_tpg.png", "TPG-robust beside TPG: IQM with 95% CIs"))
+    if three is not None:
+        probes = {}
+        if probe:
+            from mtpg.analysis.runs.champion_probe import probe_target
+
+            probes = {r.name: probe_target(r.path) for r in authors}
+        lines += authors_section(comparison, three, probes, TARGET)
     lines += ["## Cost", ""]
     lines += [
         "Wall-clock hours: the sum of `metrics.csv`'s `t_total` (every generation, test "

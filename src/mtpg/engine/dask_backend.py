@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import logging
 import os
-import sys
 import warnings
 
 import numpy as np
@@ -41,6 +40,8 @@ from mtpg.engine.batch import BatchResult, Episodes, Jobs, evaluate_roots, run_j
 from mtpg.engine.compile import CompiledPopulation, Graph
 from mtpg.engine.evaluator import BackendError, BackendLost
 from mtpg.engine.lanes import DEFAULT_LANES, run_lanes_queue
+
+_LOG = logging.getLogger(__name__)
 
 #: Batches per worker thread: enough to balance roots of uneven cost, few enough that the
 #: scheduler's cost per task (about 1.5 ms) stays negligible. Measured on paper-sized
@@ -364,7 +365,7 @@ class DaskEvaluator:
                 try:
                     thing.close()
                 except Exception as exc:  # closing a dead cluster
-                    print(f"closing the dask cluster: {exc}", file=sys.stderr)
+                    _LOG.warning(f"closing the dask cluster: {exc}")
         self.cluster = None
         _restore_log_levels(self._log_levels)
 

@@ -167,16 +167,19 @@ def test_a_compiled_task_trains_resumes_exactly_and_acts_as_a_policy(tmp_path, u
     probe = run(user_module, "probe", str(whole))
     assert " n/a " in probe and "nan" not in probe  # raw scores: no normalised ones
     run(user_module, "show", str(whole))
-    trace = ["replay", str(whole), "--task", TASK, "--episodes", "1"]
-    refused = call(user_module, *trace, "--out", str(tmp_path / "r.npz"))
-    assert refused.returncode != 0 and "Traceback" not in refused.stderr
-    assert (
-        refused.stderr.strip()
-        .splitlines()[-1]
-        .startswith(
-            "mtpg replay: error: tracing a compiled task of a user's module is not supported yet"
-        )
+    # replay traces the engine's own loop compiled for the task: evaluate's returns
+    trace = tmp_path / "r.npz"
+    run(user_module, "replay", str(whole), "--task", TASK, "--episodes", "5", "--out", str(trace))
+    with np.load(trace) as replayed:
+        assert np.mean(replayed["returns"]) == scored[TASK]["mean"]
+        assert replayed["hidden_state"].shape[1] == task.state_dim  # the task's own slots
+    gif = call(
+        user_module, "replay", str(whole), "--task", TASK, "--video", str(tmp_path / "v.gif")
     )
+    assert gif.returncode != 0 and "does not render" in gif.stderr and "Traceback" not in gif.stderr
+    run(user_module, "analyze", str(whole), "--episodes", "3", "--out", str(tmp_path / "a"))
+    analysed = json.loads((tmp_path / "a" / "analysis.json").read_text())
+    assert "not_applicable" in analysed["tasks"][TASK]  # no velocity: said, not drawn
 
 
 BAD = {

@@ -37,7 +37,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Runs the command."""
-    from mtpg.analysis.graph.page import HIDDEN_STATE_NOTE, build_analysis, not_applicable
+    from mtpg.analysis.graph.page import build_analysis, not_applicable
     from mtpg.cli.common import resolve_graph, task_list
     from mtpg.cli.main import UsageError
     from mtpg.cli.memory_option import resolve_no_memory
@@ -56,7 +56,8 @@ def run(args: argparse.Namespace) -> int:
     if args.decompose_task and args.decompose_task not in tasks:
         raise UsageError(f"--decompose-task {args.decompose_task} is not among {tasks}")
     if args.decompose_task in not_applicable(tasks):
-        raise UsageError(f"--decompose-task {args.decompose_task}: {HIDDEN_STATE_NOTE}")
+        why = not_applicable(tasks)[args.decompose_task]
+        raise UsageError(f"--decompose-task {args.decompose_task}: {why}")
     no_memory, memory_text = resolve_no_memory(args.memory, meta)
     if args.out:
         out = Path(args.out)

@@ -71,6 +71,11 @@ def run(args: argparse.Namespace) -> int:
         refusal = render_refusal(gym_task)
         if refusal:  # before the replay: nothing is written
             raise UsageError(refusal)
+    if args.video and table.is_user(table.id_of(args.task)):
+        raise UsageError(
+            f"--video: {args.task} is a compiled task of a user's module, which does not "
+            "render; --out FILE.npz writes its trace"
+        )
     replay = replay_task(pop, root, args.task, args.episodes, args.seed, no_memory, table=table)
     returns = replay["returns"]
     lengths = np.diff(replay["episode_offsets"])

@@ -89,8 +89,14 @@ def decision_bounds(graph, root: int) -> np.ndarray:
     return np.array([teams, programs, instructions, 4 * instructions], dtype=np.int64)
 
 
-def new_recorder(graph, rows: np.ndarray, steps: int, snapshot: bool) -> Recorder:
-    """Zeroed buffers: ``rows`` per log (teams, programs, instructions, memory), ``steps``."""
+def new_recorder(
+    graph, rows: np.ndarray, steps: int, snapshot: bool, state_width: int = STATE_SIZE
+) -> Recorder:
+    """Zeroed buffers: ``rows`` per log (teams, programs, instructions, memory), ``steps``.
+
+    ``state_width``: slots of the task state (a set with compiled tasks of users' modules
+    has more than the registered tasks' ``STATE_SIZE``).
+    """
     n_banks = int(graph.prog_bank.max()) + 1 if len(graph.prog_bank) else 0
     width = n_banks * graph.n_memory
     return Recorder(
@@ -104,12 +110,14 @@ def new_recorder(graph, rows: np.ndarray, steps: int, snapshot: bool) -> Recorde
         actions=np.zeros((steps, 2)),
         rewards=np.zeros(steps),
         memory=np.zeros((steps if snapshot else 0, width)),
-        states=np.zeros((steps + 1, STATE_SIZE)),
+        states=np.zeros((steps + 1, state_width)),
         observations=np.zeros((steps, 2)),
     )
 
 
-def record(run, graph, root: int, steps: int, snapshot: bool) -> tuple[Recorder, int]:
+def record(
+    run, graph, root: int, steps: int, snapshot: bool, state_width: int = STATE_SIZE
+) -> tuple[Recorder, int]:
     """Runs ``run(rec) -> decisions`` with a recorder, again with larger ones until all fit.
 
     Args:
@@ -118,6 +126,7 @@ def record(run, graph, root: int, steps: int, snapshot: bool) -> tuple[Recorder,
         root: Dense index of the root team.
         steps: Decisions expected (the first run's step rows).
         snapshot: Record every bank after each decision.
+        state_width: Slots of the task state (:func:`new_recorder`).
 
     Returns:
         The recorder with every row written, and the number of decisions.
@@ -125,7 +134,7 @@ def record(run, graph, root: int, steps: int, snapshot: bool) -> tuple[Recorder,
     steps = max(int(steps), 1)
     rows = np.minimum(decision_bounds(graph, root) * steps, FIRST_ROWS)
     while True:
-        rec = new_recorder(graph, rows, steps, snapshot)
+        rec = new_recorder(graph, rows, steps, snapshot, state_width)
         decisions = run(rec)
         counted = rec.n[list(_LOGS)]
         if decisions <= steps and np.all(counted <= rows):

@@ -11,6 +11,7 @@ since its bank was reset, it still holds the reset value 0).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,9 @@ from mtpg.engine.record import (
     record_decision,
     record_observation,
 )
+from mtpg.engine.user_kernels import kernels as user_kernels
+from mtpg.envs.dynamics.user_dispatch import USER_STATE_BASE
+from mtpg.envs.specs.contract import STATE_SIZE
 from mtpg.envs.taskset.task_table import GYM_ID_BASE, USER_ID_BASE
 
 
@@ -162,35 +166,39 @@ def trace_episode(
     snapshot: bool = False,
     obs_noise: np.ndarray | None = None,
     params: np.ndarray | None = None,
+    user: tuple = (),
 ) -> Trace:
     """Traces one episode of ``task`` from ``start`` with the episode's ``noise`` row.
 
     ``obs_noise``: the episode's rows ``[T + 1, 2]``, for a variant with observation noise;
     ``params``: the parameter table ``task`` indexes (its task table's ``params``; the
-    registered tasks' by default). ``no_memory`` is deprecated: the ablation is ``cp``'s; a
-    bool overrides it.
+    registered tasks' by default); ``user``: the table's compiled tasks of users' modules
+    (its ``user``), needed to trace one of them: the engine's own loop compiled for them
+    (:mod:`mtpg.engine.user_kernels`) plays the episode, and the trace's ``states`` are
+    the task's own slots. ``no_memory`` is deprecated: the ablation is ``cp``'s; a bool
+    overrides it.
     """
     _check_unfolded(cp)
-    if USER_ID_BASE <= task < GYM_ID_BASE:  # its state and dispatch are not the tracer's
-        raise ValueError(
-            "tracing a compiled task of a user's module is not supported yet "
-            "(replay and analyze need the registered tasks or a gym: task)"
-        )
     g = cp.with_memory_mode(no_memory).graph
     root = cp.team_index(root_id)
     table = Episodes.single(task, start, noise, obs_noise, params)
     jobs = Jobs(np.array([root], dtype=np.int64), np.zeros(1, dtype=np.int64))
     out = BatchResult.zeros(1)
+    queue, width = run_jobs_queue, STATE_SIZE
+    if USER_ID_BASE <= task < GYM_ID_BASE:  # the loop compiled for the set's compiled tasks
+        if not 0 <= task - USER_ID_BASE < len(user):
+            raise ValueError(f"task {task} is a compiled task's id: pass the table's user tasks")
+        width = table.starts.shape[1]
+        queue = user_kernels(tuple(user), USER_ID_BASE, width)[0]
 
     def run(rec: Recorder) -> int:
-        run_jobs_queue(np.zeros(1, np.int64), 1, jobs, table, out, g, rec)
+        queue(np.zeros(1, np.int64), 1, jobs, table, out, g, rec)
         return int(out.steps[0])
 
-    rec, steps = record(
-        run,
-        g,
-        root,
-        table.noise.shape[1] - 1,
-        snapshot,
-    )
-    return _trace(rec, steps)
+    rec, steps = record(run, g, root, table.noise.shape[1] - 1, snapshot, width)
+    trace = _trace(rec, steps)
+    if width == STATE_SIZE:
+        return trace
+    own = user[task - USER_ID_BASE].state_dim  # the task's own slots (user_dispatch's layout)
+    states = trace.states[:, USER_STATE_BASE : USER_STATE_BASE + own]
+    return dataclasses.replace(trace, states=np.ascontiguousarray(states))

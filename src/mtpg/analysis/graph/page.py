@@ -29,6 +29,7 @@ from mtpg.analysis.runs.hierarchical_complexity import (
     mean_by_size,
     run_complexity,
 )
+from mtpg.envs.specs.compiled_task import is_compiled_name
 from mtpg.envs.specs.gym_task import is_gym
 from mtpg.envs.taskset.task_table import TaskTable
 from mtpg.io.rundir import file_safe
@@ -39,6 +40,19 @@ HIDDEN_STATE_NOTE = (
     "no velocity prediction (Figs. 11-12 bottom) or task decomposition (Fig. 10): they "
     "need the task's hidden velocity, and a Gymnasium environment keeps its state to itself"
 )
+#: The same for a compiled task of a user's module: its state is traced, unnamed.
+UNNAMED_STATE_NOTE = (
+    "no velocity prediction (Figs. 11-12 bottom) or task decomposition (Fig. 10): they "
+    "need to know which state slot is the hidden velocity, and a compiled task of a user's "
+    "module does not say (its state is in the replay's hidden_state)"
+)
+
+
+def _no_velocity(task: str) -> str | None:
+    """Why ``task`` has no velocity analyses (None: it has them)."""
+    if is_gym(task):
+        return HIDDEN_STATE_NOTE
+    return UNNAMED_STATE_NOTE if is_compiled_name(task) else None
 
 
 def default_decompose_task(tasks: list[str]) -> str | None:
@@ -48,12 +62,12 @@ def default_decompose_task(tasks: list[str]) -> str | None:
     """
     if "Pendulum" in tasks:
         return "Pendulum"
-    return next((t for t in tasks if not is_gym(t)), None)
+    return next((t for t in tasks if _no_velocity(t) is None), None)
 
 
 def not_applicable(tasks: list[str]) -> dict[str, str]:
     """The analyses skipped for some of ``tasks``, one line per task, by task."""
-    return {t: HIDDEN_STATE_NOTE for t in tasks if is_gym(t)}
+    return {t: note for t in tasks if (note := _no_velocity(t)) is not None}
 
 
 def median_episode(returns: np.ndarray) -> int:
@@ -113,8 +127,8 @@ def build_analysis(
     decompose_task = decompose_task or default_decompose_task(tasks)
     if decompose_task is not None and decompose_task not in tasks:
         raise ValueError(f"--decompose-task {decompose_task!r} is not among the tasks analysed")
-    if decompose_task is not None and is_gym(decompose_task):
-        raise ValueError(f"--decompose-task {decompose_task}: {HIDDEN_STATE_NOTE}")
+    if decompose_task is not None and _no_velocity(decompose_task) is not None:
+        raise ValueError(f"--decompose-task {decompose_task}: {_no_velocity(decompose_task)}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     a = _Analysis(pop, root, tasks, out, episodes, seed, no_memory, label)
@@ -191,7 +205,7 @@ class _Analysis:
         one = replay_task(
             self.pop, self.root, task, 1, self.seed + typical, self.no_memory, table=self.table
         )
-        pred = None if is_gym(task) else velocity_prediction(one, 0)
+        pred = None if _no_velocity(task) else velocity_prediction(one, 0)
         name = f"timeseries_{file_safe(task)}.png"
         title = (
             f"{task}: the test episode of median return\n(seed {int(one['episode_seeds'][0])}, "
@@ -212,7 +226,7 @@ class _Analysis:
             "visit_rate": {
                 f"team {n}": float(v) for n, v in zip(visits["teams"], rates, strict=True)
             },
-            **({"not_applicable": HIDDEN_STATE_NOTE} if is_gym(task) else {}),
+            **({"not_applicable": _no_velocity(task)} if _no_velocity(task) else {}),
         }
 
     def decomposition_figure(self, task: str) -> None:

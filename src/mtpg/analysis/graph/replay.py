@@ -212,6 +212,7 @@ def replay_task(
             snapshot=e < n_mem_eps,
             obs_noise=obs_noise[e] if obs_noise.shape[1] else None,
             params=table.params,
+            user=table.user,
         )
         for e in range(episodes)
     ]

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from mtpg.model.instructions import N_CONSTANTS
+from mtpg.model.instructions import N_CONSTANTS, OP_READS, READS_A, READS_B, READS_TARGET
 
 #: Columns of a program row of the local table.
 P_LO, P_HI, P_ACT, P_BANK, P_COUNT, P_ZERO, P_GLOBAL, P_LBANK = range(8)
@@ -38,18 +38,17 @@ def registers_to_zero(instrs, lo, hi, R):
     The scalar kernel zeroes all ``R`` registers before every program run; a register the
     program writes before any read of it never shows the old value, so only the registers
     read first need the zero, and ``r[0]`` (the bid) when the program never writes it. The
-    op codes read ``src2`` always, ``src1`` for the binary ops (0..4) and the conditionals
-    (14, 15), and the target only for the conditionals. Only for ``R <= 64``: the caller
-    zeroes every register otherwise.
+    operands each op code reads are :data:`~mtpg.model.instructions.OP_READS`'s. Only for
+    ``R <= 64``: the caller zeroes every register otherwise.
     """
     one = np.uint64(1)
     written = np.uint64(0)
     need = np.uint64(0)
     for i in range(lo, hi):
         op, dst, a, b = instrs[i, 0], instrs[i, 1], instrs[i, 2], instrs[i, 3]
-        cond = op == 14 or op == 15
-        for src, read in ((b, True), (a, op <= 4 or cond), (dst, cond)):
-            if read and src < R and not (written >> np.uint64(src)) & one:
+        reads = OP_READS[op]
+        for src, bit in ((b, READS_B), (a, READS_A), (dst, READS_TARGET)):
+            if reads & bit and src < R and not (written >> np.uint64(src)) & one:
                 need |= one << np.uint64(src)
         if dst < R:
             written |= one << np.uint64(dst)

@@ -12,7 +12,14 @@ from hypothesis import given, settings
 from graph_strategies import tangled_cases
 from mtpg.engine.batch import Episodes, run_jobs
 from mtpg.engine.compile import compile_population
-from mtpg.engine.lane_graph import P_ACT, P_GLOBAL, localise, registers_to_zero, unlocalise
+from mtpg.engine.lane_graph import (
+    P_ACT,
+    P_GLOBAL,
+    localise,
+    new_local_graph,
+    registers_to_zero,
+    unlocalise,
+)
 from mtpg.engine.ops import OP_COPY
 from mtpg.engine.random_populations import layered_graphs, tangled_population
 from mtpg.envs.specs.contract import TASK_NAMES
@@ -128,16 +135,12 @@ def test_a_block_graph_is_local_and_the_maps_are_left_clean():
     rng = np.random.default_rng(4)
     pop = tangled_population(rng, 6, 20, 10, 4, 0.6)
     g = compile_population(pop).graph
-    n_teams, n_progs = len(g.team_offsets) - 1, len(g.prog_offsets) - 1
-    n_banks = int(g.prog_bank.max()) + 1
-    maps = np.full((3, max(n_teams, n_progs, n_banks)), -1, dtype=np.int64)
-    lteam, lteam_off = np.zeros(n_teams, np.int64), np.zeros(n_teams + 1, np.int64)
-    lprog = np.zeros((len(g.team_members), 8), np.int64)
-    lcode = np.zeros((len(g.instrs), 6), np.uint64)
-    lbank, counts = np.zeros(n_banks, np.int64), np.zeros(4, np.int64)
+    lg = new_local_graph(g)
+    maps, lteam, lteam_off, lprog = lg.maps, lg.teams, lg.team_offsets, lg.programs
+    assert (maps == -1).all()
     roots = np.array([0], dtype=np.int64)
-    localise(g, roots, 4, 10_000, maps, lteam, lteam_off, lprog, lcode, lbank, counts)
-    n_lt, n_lp = int(counts[0]), int(counts[1])
+    localise(g, roots, 4, 10_000, lg)
+    n_lt, n_lp = int(lg.counts[0]), int(lg.counts[1])
     assert lteam[0] == 0 and n_lt >= 1 and lteam_off[n_lt] == n_lp
     for lt in range(n_lt):  # every local team holds its global team's programs, in order
         t = lteam[lt]
@@ -145,5 +148,5 @@ def test_a_block_graph_is_local_and_the_maps_are_left_clean():
         assert list(lprog[lteam_off[lt] : lteam_off[lt + 1], P_GLOBAL]) == list(members)
         for row in lprog[lteam_off[lt] : lteam_off[lt + 1]]:  # pointers stay in the block
             assert row[P_ACT] < n_lt
-    unlocalise(maps, lteam, lprog, lbank, counts)
+    unlocalise(lg)
     assert (maps == -1).all()

@@ -96,9 +96,8 @@ def test_lane_loops_equal_apply_op(op):
     grp = rng.permutation(n_lanes).astype(np.uint64)[: n_lanes - 3]  # some lanes left out
     before = W.copy()
     every = ~np.uint64(0)
-    lane_op(
-        W, op, np.uint64(0), np.uint64(n_lanes), every, np.uint64(2 * n_lanes), every, grp, len(grp)
-    )
+    code = np.array([op, 0, n_lanes, every, 2 * n_lanes, every], dtype=np.uint64)
+    lane_op(W, code, grp, len(grp))
     in_grp = set(grp.tolist())
     for k in range(n_lanes):
         expect = want[k] if k in in_grp else before[k]
@@ -107,9 +106,8 @@ def test_lane_loops_equal_apply_op(op):
     W = before.copy()
     c = 2 * n_lanes + 5
     want = [apply_op(op, W[k], W[n_lanes + k], W[c]) for k in range(n_lanes)]
-    lane_op(
-        W, op, np.uint64(0), np.uint64(n_lanes), every, np.uint64(c), np.uint64(0), grp, len(grp)
-    )
+    code = np.array([op, 0, n_lanes, every, c, 0], dtype=np.uint64)
+    lane_op(W, code, grp, len(grp))
     for k in range(n_lanes):
         expect = want[k] if k in in_grp else before[k]
         assert _bits(W[k]) == _bits(expect), (op, k)

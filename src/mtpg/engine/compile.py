@@ -32,9 +32,10 @@ from mtpg.engine.fold import first_folded, folded_code
 from mtpg.model.graph import Population, Program
 from mtpg.model.instructions import (
     N_CONSTANTS,
-    OP_COS,
-    OP_CUBE,
-    OP_IF_LT,
+    OP_READS,
+    READS_A,
+    READS_B,
+    READS_TARGET,
     RegisterLayout,
 )
 
@@ -141,18 +142,18 @@ def _effective_kernel(code: np.ndarray, n_r: int) -> np.ndarray:
     mask = np.zeros(len(code), dtype=np.bool_)
     for k in range(len(code) - 1, -1, -1):
         op, dst, a, b = code[k, 0], code[k, 1], code[k, 2], code[k, 3]
-        cond = op >= OP_IF_LT
+        reads = OP_READS[op]  # the operands the op reads
         if dst < n_r:
             if not live[dst]:
                 continue
-            if not cond:
+            if not reads & READS_TARGET:
                 live[dst] = False
         mask[k] = True
-        if b < n_r:
+        if reads & READS_B and b < n_r:
             live[b] = True
-        if a < n_r and not (OP_COS <= op <= OP_CUBE):
+        if reads & READS_A and a < n_r:
             live[a] = True
-        if cond and dst < n_r:
+        if reads & READS_TARGET and dst < n_r:
             live[dst] = True
     return mask
 
@@ -162,9 +163,8 @@ def effective_mask(instructions: np.ndarray, layout: RegisterLayout) -> np.ndarr
 
     A backward liveness pass: the live set starts as ``{r[0]}``; every write to memory is
     effective (memory is stateful and shared); a write to ``r[i]`` is effective only when
-    ``r[i]`` is live. An effective unconditional write kills its target, then its
-    operands become live (unary operations read only the second operand; a conditional
-    also reads its target).
+    ``r[i]`` is live. An effective write kills its target unless the op reads it, then
+    the operands the op reads (:data:`~mtpg.model.instructions.OP_READS`) become live.
 
     Args:
         instructions: int array ``(n, 4)``.

@@ -41,9 +41,10 @@ from mtpg.model.graph import Program
 from mtpg.model.instructions import (
     CONSTANTS,
     N_CONSTANTS,
-    OP_COS,
-    OP_CUBE,
-    OP_IF_LT,
+    OP_READS,
+    READS_A,
+    READS_B,
+    READS_TARGET,
     RegisterLayout,
 )
 
@@ -80,11 +81,14 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
     n_val = 0
     for k in range(n):
         op, dst, a, b = code[k, 0], code[k, 1], code[k, 2], code[k, 3]
-        reads_a = not (OP_COS <= op <= OP_CUBE)  # unary operations read only b
-        cond = op >= OP_IF_LT  # conditionals also read their target
+        reads = OP_READS[op]  # the operands the op reads
+        reads_a = (reads & READS_A) != 0
+        cond = (reads & READS_TARGET) != 0  # a conditional: reads (and may negate) its target
         # Each operand read: known (and its value) or not.
         ka, va = _operand(a, known, is_known, constants, first_const) if reads_a else (True, 0.0)
-        kb, vb = _operand(b, known, is_known, constants, first_const)
+        kb, vb = (
+            _operand(b, known, is_known, constants, first_const) if reads & READS_B else (True, 0.0)
+        )
         kd, vd = (is_known[dst], known[dst]) if cond else (True, 0.0)
         if ka and kb and kd:
             v = apply_op(op, vd, va, vb)
@@ -98,8 +102,8 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
             n_val += 1
             n_out += 1
             continue
-        if cond and ka and kb and not (va < vb if op == OP_IF_LT else va > vb):
-            continue  # a condition known to be false: the instruction changes nothing
+        if cond and ka and kb and apply_op(op, 1.0, va, vb) == 1.0:
+            continue  # a condition known to be false (1 not negated): changes nothing
         # Executed: reads of known private registers go to the pool instead.
         if cond and dst < n_r and is_known[dst]:
             values[n_val] = known[dst]
@@ -111,7 +115,7 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
             values[n_val] = known[a]
             a = first_folded + n_val
             n_val += 1
-        if b < n_r and is_known[b]:
+        if reads & READS_B and b < n_r and is_known[b]:
             values[n_val] = known[b]
             b = first_folded + n_val
             n_val += 1

@@ -18,10 +18,12 @@ mask (:func:`~mtpg.engine.lane_ops.lane_op`).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from mtpg.model.instructions import N_CONSTANTS
+from mtpg.model.instructions import N_CONSTANTS, OP_READS, READS_A, READS_B, READS_TARGET
 
 #: Columns of a program row of the local table.
 P_LO, P_HI, P_ACT, P_BANK, P_COUNT, P_ZERO, P_GLOBAL, P_LBANK = range(8)
@@ -38,18 +40,17 @@ def registers_to_zero(instrs, lo, hi, R):
     The scalar kernel zeroes all ``R`` registers before every program run; a register the
     program writes before any read of it never shows the old value, so only the registers
     read first need the zero, and ``r[0]`` (the bid) when the program never writes it. The
-    op codes read ``src2`` always, ``src1`` for the binary ops (0..4) and the conditionals
-    (14, 15), and the target only for the conditionals. Only for ``R <= 64``: the caller
-    zeroes every register otherwise.
+    operands each op code reads are :data:`~mtpg.model.instructions.OP_READS`'s. Only for
+    ``R <= 64``: the caller zeroes every register otherwise.
     """
     one = np.uint64(1)
     written = np.uint64(0)
     need = np.uint64(0)
     for i in range(lo, hi):
         op, dst, a, b = instrs[i, 0], instrs[i, 1], instrs[i, 2], instrs[i, 3]
-        cond = op == 14 or op == 15
-        for src, read in ((b, True), (a, op <= 4 or cond), (dst, cond)):
-            if read and src < R and not (written >> np.uint64(src)) & one:
+        reads = OP_READS[op]
+        for src, bit in ((b, READS_B), (a, READS_A), (dst, READS_TARGET)):
+            if reads & bit and src < R and not (written >> np.uint64(src)) & one:
                 need |= one << np.uint64(src)
         if dst < R:
             written |= one << np.uint64(dst)
@@ -59,17 +60,17 @@ def registers_to_zero(instrs, lo, hi, R):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _bank_of(bank, bank_map, lbank, n_lb):
-    """The local number of global bank ``bank``, numbering it when new."""
+def _bank_of(bank, bank_map, lbank, counts):
+    """The local number of global bank ``bank``, numbering it when new (``counts[3]``)."""
     if bank_map[bank] < 0:
-        bank_map[bank] = n_lb[0]
-        lbank[n_lb[0]] = bank
-        n_lb[0] += 1
+        bank_map[bank] = counts[3]
+        lbank[counts[3]] = bank
+        counts[3] += 1
     return bank_map[bank]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _operand(x, g, lanes, shared, bank_map, lbank, n_lb):
+def _operand(x, g, lanes, shared, bank_map, lbank, counts):
     """Lane-workspace address and lane mask of scalar-workspace address ``x``."""
     R, M, base = g.n_registers, g.n_memory, g.mem_base
     K = len(g.folded)
@@ -82,36 +83,64 @@ def _operand(x, g, lanes, shared, bank_map, lbank, n_lb):
         return np.uint64((x - N_CONSTANTS) * lanes), ALL_LANES
     if x < base:
         return np.uint64(shared + N_CONSTANTS + x - (base - K)), np.uint64(0)
-    bank = _bank_of((x - base) // M, bank_map, lbank, n_lb)
+    bank = _bank_of((x - base) // M, bank_map, lbank, counts)
     row = R + n_obs + bank * M + (x - base) % M
     return np.uint64(row * lanes), ALL_LANES
 
 
-@njit(cache=True, error_model="numpy")
-def localise(g, roots, lanes, shared, maps, lteam, lteam_off, lprog, lcode, lbank, counts):
-    """Builds the block's local graph from the dense roots ``roots``.
+class LocalGraph(NamedTuple):
+    """A lane block's own graph (:func:`localise`), one per worker, rewritten per block.
 
-    Args:
-        g: The compiled graph.
-        roots: int64 dense root teams of the block (distinct).
-        lanes: Lanes per row of the workspace.
-        shared: Workspace index of the shared constants.
+    Attributes:
         maps: int64 ``[3, max(n_teams, n_programs, n_banks)]``: global to local team,
-            program (start of its code in ``lcode``) and bank; -1 where none, as
+            program (start of its code in ``code``) and bank; -1 where none, as
             :func:`unlocalise` leaves them.
-        lteam: int64: local team -> global team (written).
-        lteam_off: int64: the programs of local team ``t`` are rows
-            ``lteam_off[t]:lteam_off[t + 1]`` of ``lprog`` (written).
-        lprog: int64 ``[len(team_members), 8]``: program rows (``P_*`` columns; the action
-            as ``-1 - a`` or a local team; the bank as the workspace index of its row 0).
-        lcode: uint64 ``[n_instructions, 6]``: translated code (``C_*`` columns).
-        lbank: int64: local bank -> global bank (written).
-        counts: int64 ``[4]``: teams, program rows, code rows and banks (written).
+        teams: int64: local team -> global team.
+        team_offsets: int64: the programs of local team ``t`` are rows
+            ``team_offsets[t]:team_offsets[t + 1]`` of ``programs``.
+        programs: int64 ``[len(team_members), 8]``: program rows (``P_*`` columns; the
+            action as ``-1 - a`` or a local team; the bank as the workspace index of its
+            row 0).
+        code: uint64 ``[n_instructions, 6]``: translated code (``C_*`` columns).
+        banks: int64: local bank -> global bank.
+        counts: int64 ``[4]``: teams, program rows, code rows and banks of the block.
     """
-    team_map, prog_map, bank_map = maps[0], maps[1], maps[2]
-    R, M = g.n_registers, g.n_memory
-    K = len(g.folded)
-    n_obs = g.mem_base - K - (R + N_CONSTANTS)
+
+    maps: np.ndarray
+    teams: np.ndarray
+    team_offsets: np.ndarray
+    programs: np.ndarray
+    code: np.ndarray
+    banks: np.ndarray
+    counts: np.ndarray
+
+
+@njit(cache=True, error_model="numpy")
+def new_local_graph(g) -> LocalGraph:
+    """Allocates a :class:`LocalGraph` large enough for any block of the graph ``g``.
+
+    Only ``maps`` must hold -1 from the start; the other arrays are written by
+    :func:`localise` before they are read, so they are left unfilled (and a large
+    population's arrays cost no page of memory that a block does not use).
+    """
+    n_teams = len(g.team_offsets) - 1
+    n_progs = len(g.prog_offsets) - 1
+    n_banks = (g.prog_bank.max() + 1) if n_progs else 0
+    return LocalGraph(
+        np.full((3, max(n_teams, n_progs, n_banks, 1)), -1, dtype=np.int64),
+        np.empty(n_teams, dtype=np.int64),
+        np.empty(n_teams + 1, dtype=np.int64),
+        np.empty((len(g.team_members), 8), dtype=np.int64),
+        np.empty((len(g.instrs), 6), dtype=np.uint64),
+        np.empty(max(n_banks, 1), dtype=np.int64),
+        np.zeros(4, dtype=np.int64),
+    )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _reachable(g, roots, lg):
+    """Numbers the teams reachable from ``roots`` breadth first; returns their number."""
+    team_map, lteam = lg.maps[0], lg.teams
     n_lt = 0
     for r in roots:
         if team_map[r] < 0:
@@ -119,7 +148,7 @@ def localise(g, roots, lanes, shared, maps, lteam, lteam_off, lprog, lcode, lban
             lteam[n_lt] = r
             n_lt += 1
     i = 0
-    while i < n_lt:  # breadth first: every team reachable from the roots
+    while i < n_lt:
         t = lteam[i]
         i += 1
         for k in range(g.team_offsets[t], g.team_offsets[t + 1]):
@@ -128,31 +157,59 @@ def localise(g, roots, lanes, shared, maps, lteam, lteam_off, lprog, lcode, lban
                 team_map[a] = n_lt
                 lteam[n_lt] = a
                 n_lt += 1
-    n_lb = np.zeros(1, dtype=np.int64)
+    return n_lt
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _translate(g, p, lanes, shared, lg, n_lc):
+    """Writes program ``p``'s code to ``lg.code`` from row ``n_lc``, operands translated."""
+    bank_map, lbank, counts, lcode = lg.maps[2], lg.banks, lg.counts, lg.code
+    for j in range(g.prog_offsets[p], g.prog_offsets[p + 1]):
+        ins = g.instrs[j]
+        d, _ = _operand(ins[1], g, lanes, shared, bank_map, lbank, counts)
+        ua, ma = _operand(ins[2], g, lanes, shared, bank_map, lbank, counts)
+        ub, mb = _operand(ins[3], g, lanes, shared, bank_map, lbank, counts)
+        lcode[n_lc, C_OP] = ins[0]
+        lcode[n_lc, C_DST] = d
+        lcode[n_lc, C_A] = ua
+        lcode[n_lc, C_MA] = ma
+        lcode[n_lc, C_B] = ub
+        lcode[n_lc, C_MB] = mb
+        n_lc += 1
+    return n_lc
+
+
+@njit(cache=True, error_model="numpy")
+def localise(g, roots, lanes, shared, lg):
+    """Builds the block's local graph :class:`LocalGraph` ``lg`` from the dense roots.
+
+    Args:
+        g: The compiled graph.
+        roots: int64 dense root teams of the block (distinct).
+        lanes: Lanes per row of the workspace.
+        shared: Workspace index of the shared constants.
+        lg: The worker's :class:`LocalGraph`, its ``maps`` all -1 (written: the block's
+            teams, programs, code and banks, and their ``counts``).
+    """
+    team_map, prog_map, bank_map = lg.maps[0], lg.maps[1], lg.maps[2]
+    lteam_off, lprog, counts = lg.team_offsets, lg.programs, lg.counts
+    R, M = g.n_registers, g.n_memory
+    n_obs = g.mem_base - len(g.folded) - (R + N_CONSTANTS)
+    n_lt = _reachable(g, roots, lg)
+    counts[3] = 0  # the banks, numbered as programs name them
     n_lp = 0
     n_lc = 0
     for lt in range(n_lt):
-        t = lteam[lt]
+        t = lg.teams[lt]
         lteam_off[lt] = n_lp
         for k in range(g.team_offsets[t], g.team_offsets[t + 1]):
             p = g.team_members[k]
             lo, hi = g.prog_offsets[p], g.prog_offsets[p + 1]
             if prog_map[p] < 0:  # the code once per program, however many teams hold it
                 prog_map[p] = n_lc
-                for j in range(lo, hi):
-                    ins = g.instrs[j]
-                    d, _ = _operand(ins[1], g, lanes, shared, bank_map, lbank, n_lb)
-                    ua, ma = _operand(ins[2], g, lanes, shared, bank_map, lbank, n_lb)
-                    ub, mb = _operand(ins[3], g, lanes, shared, bank_map, lbank, n_lb)
-                    lcode[n_lc, C_OP] = ins[0]
-                    lcode[n_lc, C_DST] = d
-                    lcode[n_lc, C_A] = ua
-                    lcode[n_lc, C_MA] = ma
-                    lcode[n_lc, C_B] = ub
-                    lcode[n_lc, C_MB] = mb
-                    n_lc += 1
+                n_lc = _translate(g, p, lanes, shared, lg, n_lc)
             a = g.prog_action[p]
-            bank = _bank_of(g.prog_bank[p], bank_map, lbank, n_lb)
+            bank = _bank_of(g.prog_bank[p], bank_map, lg.banks, counts)
             lprog[n_lp, P_LO] = prog_map[p]
             lprog[n_lp, P_HI] = prog_map[p] + (hi - lo)
             lprog[n_lp, P_ACT] = a if a < 0 else team_map[a]
@@ -165,15 +222,16 @@ def localise(g, roots, lanes, shared, maps, lteam, lteam_off, lprog, lcode, lban
             lprog[n_lp, P_LBANK] = bank
             n_lp += 1
     lteam_off[n_lt] = n_lp
-    counts[0], counts[1], counts[2], counts[3] = n_lt, n_lp, n_lc, n_lb[0]
+    counts[0], counts[1], counts[2] = n_lt, n_lp, n_lc
 
 
 @njit(cache=True, error_model="numpy")
-def unlocalise(maps, lteam, lprog, lbank, counts):
-    """Resets the entries of ``maps`` that :func:`localise` set, back to -1."""
+def unlocalise(lg):
+    """Resets the entries of ``lg.maps`` that :func:`localise` set, back to -1."""
+    maps, counts = lg.maps, lg.counts
     for i in range(counts[0]):
-        maps[0, lteam[i]] = -1
+        maps[0, lg.teams[i]] = -1
     for i in range(counts[1]):
-        maps[1, lprog[i, P_GLOBAL]] = -1
+        maps[1, lg.programs[i, P_GLOBAL]] = -1
     for i in range(counts[3]):
-        maps[2, lbank[i]] = -1
+        maps[2, lg.banks[i]] = -1

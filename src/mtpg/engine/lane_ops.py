@@ -11,19 +11,24 @@ import math
 
 from numba import njit
 
+from mtpg.engine.lane_graph import C_A, C_B, C_DST, C_MA, C_MB, C_OP
 from mtpg.engine.ops import _clamp, op_cos, op_div, op_exp, op_log, op_pow, op_sin, op_tanh
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def lane_op(Wf, op, ud, ua, ma, ub, mb, grp, n):
+def lane_op(Wf, c, grp, n):
     """Runs one instruction over the lanes ``grp[:n]``: one loop per op code.
 
-    Operand ``x`` of lane ``l`` is ``Wf[ux + (l & mx)]``: a lane's own value (``mx`` all
-    ones) or one value shared by all lanes (``mx = 0``: a constant).
+    ``c`` is the instruction as :func:`~mtpg.engine.lane_graph.localise` translates it
+    (uint64, ``C_*`` columns of :mod:`mtpg.engine.lane_graph`): op code, target address
+    ``ud``, operand addresses ``ua``, ``ub`` and their lane masks ``ma``, ``mb``. Operand
+    ``x`` of lane ``l`` is ``Wf[ux + (l & mx)]``: a lane's own value (``mx`` all ones) or
+    one value shared by all lanes (``mx = 0``: a constant).
 
     Each loop computes :func:`~mtpg.engine.ops.apply_op`'s value for its op code with the
     same functions, so the op code is tested once per group, not once per lane.
     """
+    op, ud, ua, ma, ub, mb = c[C_OP], c[C_DST], c[C_A], c[C_MA], c[C_B], c[C_MB]
     if op == 0:
         for k in range(n):
             lane = grp[k]

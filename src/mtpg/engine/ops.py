@@ -1,8 +1,9 @@
 """The protected operations of Table 2 as one compiled function.
 
 The semantics (and the protection table) are documented in
-:mod:`mtpg.model.instructions`; the reference interpreter implements the same table in
-plain Python with the same floating-point operations.
+:mod:`mtpg.model.instructions`, which also holds the one table of the operands each op
+reads (:data:`~mtpg.model.instructions.OP_READS`); the reference interpreter implements
+the same arithmetic in plain Python with the same floating-point operations.
 """
 
 from __future__ import annotations
@@ -14,11 +15,8 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, LOG_TINY, N_OPS
-
-#: Engine-only op code (never in a program): ``dst <- src2``, the copy that constant
-#: folding (:mod:`mtpg.engine.fold`) writes where a known value must reach a register.
-OP_COPY = N_OPS
+from mtpg.model.instructions import BIG, DIV_EPS, LOG_BIG, LOG_TINY
+from mtpg.model.instructions import OP_COPY as OP_COPY  # the engine-only op, re-exported
 
 
 @intrinsic

@@ -20,11 +20,8 @@ import numpy as np
 from numba import njit
 
 from mtpg.envs.specs.contract import STATE_SIZE
-from mtpg.model.instructions import CONDITIONAL_OPS, UNARY_OPS
+from mtpg.model.instructions import OP_READS, READS_A, READS_B, READS_TARGET
 
-_FIRST_UNARY = min(UNARY_OPS)
-_LAST_UNARY = max(UNARY_OPS)
-_FIRST_COND = min(CONDITIONAL_OPS)
 #: Most rows per log a first run is given (a run needing more is played again).
 FIRST_ROWS = 1 << 18
 
@@ -191,22 +188,21 @@ def _memory_access(rec: Recorder, cell, M, is_write) -> None:
 def record_instruction(rec: Recorder, i, instr, old, value, base, M) -> None:
     """Instruction ``i`` (row ``instr``) turned its target from ``old`` into ``value``.
 
-    Logs the instruction, then each memory register it read (a conditional reads its
-    target, a unary operation only its second operand), then its memory write: every
-    write of an unconditional operation, and a conditional's when it changed the value.
+    Logs the instruction, then each memory register it read (target, first, second
+    operand: those the op reads, :data:`~mtpg.model.instructions.OP_READS`), then its
+    memory write: every write of an op that does not read its target, and a
+    conditional's (which does) when it changed the value.
     """
     k = _count(rec, INSTRUCTIONS, rec.instr_log.shape[0])
     if k >= 0:
         rec.instr_log[k, 0] = rec.n[STEP]
         rec.instr_log[k, 1] = i
-    op = instr[0]
+    reads = OP_READS[instr[0]]
     dst, a, b = np.int64(instr[1]), np.int64(instr[2]), np.int64(instr[3])
-    cond = op >= _FIRST_COND
-    unary = _FIRST_UNARY <= op <= _LAST_UNARY
-    for src in (dst if cond else np.int64(-1), np.int64(-1) if unary else a, b):
-        if src >= base:
+    for src, bit in ((dst, READS_TARGET), (a, READS_A), (b, READS_B)):
+        if reads & bit and src >= base:
             _memory_access(rec, src - base, M, 0)
-    if dst >= base and (value != old or not cond):
+    if dst >= base and (value != old or not (reads & READS_TARGET)):
         _memory_access(rec, dst - base, M, 1)
         rec.last_write[dst - base] = rec.n[STEP]
 

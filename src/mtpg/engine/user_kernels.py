@@ -25,17 +25,34 @@ from mtpg.envs.specs.compiled_task import CompiledTask
 
 
 def _rebound(fn: Any, names: dict, **options: Any) -> Any:
-    """``fn`` (a Numba function) compiled again with some of its global names replaced."""
+    """``fn`` (a Numba function) compiled again with some of its global names replaced.
+
+    Every name must be one the function reads (a name it does not read would rebind
+    nothing: a dispatch call moved into a helper then still calls the registered tasks).
+    The copy keeps the original's compile options (``inline``, ``_nrt``, ...), but not
+    its cache.
+    """
     py = fn.py_func
+    missing = set(names) - set(py.__code__.co_names)
+    if missing:
+        raise AssertionError(f"{py.__name__} reads no global {sorted(missing)}")
     scope = {**py.__globals__, **names}
     copy = types.FunctionType(py.__code__, scope, py.__name__, py.__defaults__, py.__closure__)
     copy.__doc__ = py.__doc__
-    return njit(error_model="numpy", **options)(copy)
+    kept = {k: v for k, v in fn.targetoptions.items() if k != "nopython"}  # njit's own
+    return njit(**{**kept, **options})(copy)
 
 
 @cache
 def kernels(tasks: tuple[CompiledTask, ...], first_id: int, width: int) -> tuple[Any, Any]:
     """The engine's episode loops and their parallel drivers for a set of compiled tasks.
+
+    Every function of the loops that calls the dispatch, or allocates the state, is
+    compiled again, and so is every function calling one of those: in the scalar loop
+    ``thread_buffers`` and ``run_jobs_queue``; in the lane engine ``lane_buffers``,
+    ``start_lanes``, ``step_lanes``, ``play_block`` (which inlines ``step_lanes``) and
+    ``run_lanes_queue`` (the decision steps, :mod:`mtpg.engine.lane_decide`, call no
+    task).
 
     Args:
         tasks: The compiled tasks; task ``k`` has id ``first_id + k``.
@@ -53,7 +70,13 @@ def kernels(tasks: tuple[CompiledTask, ...], first_id: int, width: int) -> tuple
         episode_kernels.run_jobs_queue, {**dispatch, "thread_buffers": buffers}, nogil=True
     )
     parallel = _rebound(episode_kernels.run_jobs_parallel, {"run_jobs_queue": queue}, parallel=True)
-    lane_queue = _rebound(lanes.run_lanes_queue, {**dispatch, "STATE_SIZE": width}, nogil=True)
+    lane_steps = {
+        "lane_buffers": _rebound(lanes.lane_buffers, {"STATE_SIZE": width}),
+        "start_lanes": _rebound(lanes.start_lanes, {"env_reset": reset, "task_observe": observe}),
+    }
+    step_lanes = _rebound(lanes.step_lanes, {"task_observe": observe, "task_step": step})
+    lane_steps["play_block"] = _rebound(lanes.play_block, {"step_lanes": step_lanes})
+    lane_queue = _rebound(lanes.run_lanes_queue, lane_steps, nogil=True)
     lane_parallel = _rebound(
         lanes.run_lanes_parallel, {"run_lanes_queue": lane_queue}, parallel=True
     )

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, action_text
 from mtpg.export.lowering import Operand
+from mtpg.model.instructions import OP_NAMES, operands_read
 
 #: C library functions that are not correctly rounded, by the ops calling them. They are
 #: called through volatile pointers so that no compiler can evaluate them at compile time
@@ -44,33 +45,39 @@ _LIBM: dict[str, tuple[str, ...]] = {
     "tanh": ("tanh",),
 }
 
-#: Body of each protected operation; ``d`` is the target's current value.
-_OPS: dict[str, tuple[str, str]] = {
-    "add": ("double a, double b", "return mtpg_clamp(a + b);"),
-    "sub": ("double a, double b", "return mtpg_clamp(a - b);"),
-    "mul": ("double a, double b", "return mtpg_clamp(a * b);"),
-    "div": ("double a, double b", "return mtpg_clamp(fabs(b) < MTPG_DIV_EPS ? a : a / b);"),
+#: Body of each protected operation; its parameters are the operands it reads
+#: (:func:`~mtpg.model.instructions.operands_read`; ``d`` is the target's current value).
+_OPS: dict[str, str] = {
+    "add": "return mtpg_clamp(a + b);",
+    "sub": "return mtpg_clamp(a - b);",
+    "mul": "return mtpg_clamp(a * b);",
+    "div": "return mtpg_clamp(fabs(b) < MTPG_DIV_EPS ? a : a / b);",
     "pow": (
-        "double a, double b",
         "double x = fabs(a), e;\n"
         "    if (x == 0.0)\n        return 0.0;\n"
         "    e = b * mtpg_log(x);\n"
         "    if (e > MTPG_LOG_BIG)\n        return MTPG_BIG;\n"
         "    if (e < MTPG_LOG_TINY)\n        return 0.0;\n"
-        "    return mtpg_clamp(mtpg_pow(x, b));",
+        "    return mtpg_clamp(mtpg_pow(x, b));"
     ),
-    "cos": ("double b", "return mtpg_clamp(mtpg_cos(b));"),
-    "ln": ("double b", "return mtpg_clamp(b == 0.0 ? 0.0 : mtpg_log(fabs(b)));"),
-    "exp": ("double b", "return mtpg_clamp(b > MTPG_LOG_BIG ? MTPG_BIG : mtpg_exp(b));"),
-    "sqrt": ("double b", "return mtpg_clamp(sqrt(fabs(b)));"),
-    "sin": ("double b", "return mtpg_clamp(mtpg_sin(b));"),
-    "tanh": ("double b", "return mtpg_clamp(mtpg_tanh(b));"),
-    "square": ("double b", "return mtpg_clamp(b * b);"),
-    "abs": ("double b", "return mtpg_clamp(fabs(b));"),
-    "cube": ("double b", "return mtpg_clamp(b * b * b);"),
-    "if_lt": ("double d, double a, double b", "return mtpg_clamp(a < b ? -d : d);"),
-    "if_gt": ("double d, double a, double b", "return mtpg_clamp(a > b ? -d : d);"),
+    "cos": "return mtpg_clamp(mtpg_cos(b));",
+    "ln": "return mtpg_clamp(b == 0.0 ? 0.0 : mtpg_log(fabs(b)));",
+    "exp": "return mtpg_clamp(b > MTPG_LOG_BIG ? MTPG_BIG : mtpg_exp(b));",
+    "sqrt": "return mtpg_clamp(sqrt(fabs(b)));",
+    "sin": "return mtpg_clamp(mtpg_sin(b));",
+    "tanh": "return mtpg_clamp(mtpg_tanh(b));",
+    "square": "return mtpg_clamp(b * b);",
+    "abs": "return mtpg_clamp(fabs(b));",
+    "cube": "return mtpg_clamp(b * b * b);",
+    "if_lt": "return mtpg_clamp(a < b ? -d : d);",
+    "if_gt": "return mtpg_clamp(a > b ? -d : d);",
 }
+
+
+def op_function(name: str) -> str:
+    """The generated function of operation ``name``: one parameter per operand it reads."""
+    params = ", ".join(f"double {x}" for x in operands_read(OP_NAMES.index(name)))
+    return f"static double mtpg_op_{name}({params})\n{{\n    {_OPS[name]}\n}}"
 
 
 def _params(function: str) -> str:
@@ -237,9 +244,7 @@ def source_text(graph: ExportGraph, name: str) -> str:
             "static double mtpg_clamp(double v)\n{\n    if (v > MTPG_BIG)\n        return MTPG_BIG;"
             "\n    if (v < -MTPG_BIG)\n        return -MTPG_BIG;\n    return v;\n}"
         )
-    for op in used:
-        params, body = _OPS[op]
-        parts.append(f"static double mtpg_op_{op}({params})\n{{\n    {body}\n}}")
+    parts.extend(op_function(op) for op in used)
     for k, prog in enumerate(graph.programs):
         parts.append(_program_function(graph, k, prog))
     parts.append(

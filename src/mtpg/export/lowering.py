@@ -24,13 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mtpg.engine.oracle import reference_op
-from mtpg.model.instructions import (
-    BINARY_OPS,
-    CONDITIONAL_OPS,
-    CONSTANTS,
-    OP_NAMES,
-    RegisterLayout,
-)
+from mtpg.model.instructions import CONSTANTS, OP_NAMES, RegisterLayout, operands_read
 
 #: An operand: ``("r", i)``, ``("m", j)``, ``("s", k)`` or a literal ``("c", value)``.
 Operand = tuple[str, int | float]
@@ -44,9 +38,9 @@ class Statement:
         target: ``("r", i)`` or ``("m", j)``.
         op: Operation name (:data:`mtpg.model.instructions.OP_NAMES`), or None for a
             store of a literal.
-        args: Operands in the order of the operation: the target's value first for the
-            conditionals, then the first operand for binary operations and the
-            conditionals, then the second operand.
+        args: The operands the operation reads, in argument order
+            (:func:`~mtpg.model.instructions.operands_read`: the target's value, the
+            first operand, the second operand, each where the op reads it).
     """
 
     target: Operand
@@ -93,17 +87,13 @@ def lower(
 
     for op, dst, a, b in np.asarray(code).tolist():
         target = _logical(dst, layout)
-        if op in CONDITIONAL_OPS:
-            args = (read(dst), read(a), read(b))
-        elif op in BINARY_OPS:
-            args = (read(a), read(b))
-        else:
-            args = (read(b),)
+        names = operands_read(op)  # the operands the op reads, in argument order
+        operand = {"d": dst, "a": a, "b": b}
+        args = tuple(read(operand[name]) for name in names)
         if all(kind == "c" for kind, _ in args):
-            values = [float(v) for _, v in args]
-            d = values[0] if op in CONDITIONAL_OPS else 0.0
-            x = values[-2] if len(values) > 1 else 0.0
-            result = reference_op(op, d, x, values[-1])
+            values = {"d": 0.0, "a": 0.0, "b": 0.0}
+            values.update((name, float(v)) for name, (_, v) in zip(names, args, strict=True))
+            result = reference_op(op, values["d"], values["a"], values["b"])
             known[target] = result
             folded += 1
             if target[0] == "m":

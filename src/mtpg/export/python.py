@@ -20,31 +20,38 @@ from pathlib import Path
 
 from mtpg.export.common import TABLE_CONSTANTS, ExportGraph, ExportProgram, action_text
 from mtpg.export.lowering import Operand
+from mtpg.model.instructions import OP_NAMES, operands_read
 
-#: Expression of each protected operation (``d`` target, ``a``/``b`` operands).
-_OPS: dict[str, tuple[str, str]] = {
-    "add": ("a, b", "return _clamp(a + b)"),
-    "sub": ("a, b", "return _clamp(a - b)"),
-    "mul": ("a, b", "return _clamp(a * b)"),
-    "div": ("a, b", "return _clamp(a if abs(b) < DIV_EPS else a / b)"),
+#: Body of each protected operation; its parameters are the operands it reads
+#: (:func:`~mtpg.model.instructions.operands_read`: ``d`` target, ``a``/``b`` operands).
+_OPS: dict[str, str] = {
+    "add": "return _clamp(a + b)",
+    "sub": "return _clamp(a - b)",
+    "mul": "return _clamp(a * b)",
+    "div": "return _clamp(a if abs(b) < DIV_EPS else a / b)",
     "pow": (
-        "a, b",
         "x = abs(a)\n    if x == 0.0:\n        return 0.0\n    e = b * math.log(x)\n"
         "    if e > LOG_BIG:\n        return BIG\n    if e < LOG_TINY:\n        return 0.0\n"
-        "    return _clamp(math.pow(x, b))",
+        "    return _clamp(math.pow(x, b))"
     ),
-    "cos": ("b", "return _clamp(math.cos(b))"),
-    "ln": ("b", "return _clamp(0.0 if b == 0.0 else math.log(abs(b)))"),
-    "exp": ("b", "return _clamp(BIG if b > LOG_BIG else math.exp(b))"),
-    "sqrt": ("b", "return _clamp(math.sqrt(abs(b)))"),
-    "sin": ("b", "return _clamp(math.sin(b))"),
-    "tanh": ("b", "return _clamp(math.tanh(b))"),
-    "square": ("b", "return _clamp(b * b)"),
-    "abs": ("b", "return _clamp(abs(b))"),
-    "cube": ("b", "return _clamp(b * b * b)"),
-    "if_lt": ("d, a, b", "return _clamp(-d if a < b else d)"),
-    "if_gt": ("d, a, b", "return _clamp(-d if a > b else d)"),
+    "cos": "return _clamp(math.cos(b))",
+    "ln": "return _clamp(0.0 if b == 0.0 else math.log(abs(b)))",
+    "exp": "return _clamp(BIG if b > LOG_BIG else math.exp(b))",
+    "sqrt": "return _clamp(math.sqrt(abs(b)))",
+    "sin": "return _clamp(math.sin(b))",
+    "tanh": "return _clamp(math.tanh(b))",
+    "square": "return _clamp(b * b)",
+    "abs": "return _clamp(abs(b))",
+    "cube": "return _clamp(b * b * b)",
+    "if_lt": "return _clamp(-d if a < b else d)",
+    "if_gt": "return _clamp(-d if a > b else d)",
 }
+
+
+def op_function(name: str) -> str:
+    """The generated function of operation ``name``: one parameter per operand it reads."""
+    params = ", ".join(operands_read(OP_NAMES.index(name)))
+    return f"def _{name}({params}):\n    {_OPS[name]}"
 
 
 def _operand(operand: Operand) -> str:
@@ -141,9 +148,7 @@ import math''',
         "def _clamp(v):\n    if v > BIG:\n        return BIG\n"
         "    if v < -BIG:\n        return -BIG\n    return v",
     ]
-    for op in used:
-        params, body = _OPS[op]
-        parts.append(f"def _{op}({params}):\n    {body}")
+    parts.extend(op_function(op) for op in used)
     parts.extend(_program_function(graph, k, p) for k, p in enumerate(graph.programs))
     parts.extend(_team_function(graph, t) for t in range(len(graph.teams)))
     parts.append(f"_TEAMS = ({', '.join(f'_t{t}' for t in range(len(graph.teams)))},)")

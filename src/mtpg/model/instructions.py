@@ -53,35 +53,75 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Operation codes, in op-code order.
-OP_NAMES: tuple[str, ...] = (
-    "add",
-    "sub",
-    "mul",
-    "div",
-    "pow",
-    "cos",
-    "ln",
-    "exp",
-    "sqrt",
-    "sin",
-    "tanh",
-    "square",
-    "abs",
-    "cube",
-    "if_lt",
-    "if_gt",
+#: Bits of an :data:`OP_READS` entry: the operands an op code reads. ``READS_TARGET``: the
+#: target's old value (the conditionals, which may negate it); ``READS_A``: the first
+#: operand ``src1``; ``READS_B``: the second operand ``src2``.
+READS_TARGET, READS_A, READS_B = 1, 2, 4
+_BINARY = READS_A | READS_B
+_UNARY = READS_B
+_CONDITIONAL = READS_TARGET | READS_A | READS_B
+
+#: The op semantics table, one row per op code in op-code order: the op's name and the
+#: operands it reads. Every part of the package that asks which operands an instruction
+#: reads (intron removal, constant folding, the lane engine's register zeroing, the
+#: tracer's memory log, the exporters and :func:`disassemble`) reads this table; the
+#: arithmetic of each op is written in :func:`mtpg.engine.ops.apply_op` (and its lane,
+#: reference and exported copies, tested against it). The last row, ``copy``
+#: (:data:`OP_COPY`: ``dst <- src2``), is the engine's own: constant folding writes it,
+#: no program holds it. Adding an op is one row here, before ``copy``, plus its
+#: arithmetic; tests/engine/test_op_reads.py proves every consumer agrees with the table.
+OP_TABLE: tuple[tuple[str, int], ...] = (
+    ("add", _BINARY),
+    ("sub", _BINARY),
+    ("mul", _BINARY),
+    ("div", _BINARY),
+    ("pow", _BINARY),
+    ("cos", _UNARY),
+    ("ln", _UNARY),
+    ("exp", _UNARY),
+    ("sqrt", _UNARY),
+    ("sin", _UNARY),
+    ("tanh", _UNARY),
+    ("square", _UNARY),
+    ("abs", _UNARY),
+    ("cube", _UNARY),
+    ("if_lt", _CONDITIONAL),
+    ("if_gt", _CONDITIONAL),
+    ("copy", _UNARY),
 )
+#: Engine-only op code (never in a program): ``dst <- src2``, the copy that constant
+#: folding (:mod:`mtpg.engine.fold`) writes where a known value must reach a register.
+OP_COPY = len(OP_TABLE) - 1
+#: The operands each op code reads (``READS_*`` bits), indexed by op code, ``OP_COPY``
+#: included: an int64 array, so compiled kernels index it as a constant.
+OP_READS = np.array([reads for _, reads in OP_TABLE], dtype=np.int64)
+OP_READS.flags.writeable = False
+#: Operation codes of programs, in op-code order.
+OP_NAMES: tuple[str, ...] = tuple(name for name, _ in OP_TABLE[:OP_COPY])
 N_OPS = len(OP_NAMES)
 OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW = range(5)
 OP_COS, OP_LN, OP_EXP, OP_SQRT, OP_SIN, OP_TANH, OP_SQUARE, OP_ABS, OP_CUBE = range(5, 14)
 OP_IF_LT, OP_IF_GT = 14, 15
 #: Op codes whose result depends on the first operand (binary operations).
-BINARY_OPS = frozenset(range(0, 5))
+BINARY_OPS = frozenset(op for op in range(N_OPS) if OP_READS[op] == _BINARY)
 #: Op codes reading only the second operand.
-UNARY_OPS = frozenset(range(5, 14))
+UNARY_OPS = frozenset(op for op in range(N_OPS) if OP_READS[op] == _UNARY)
 #: Op codes that read the target and may negate it.
-CONDITIONAL_OPS = frozenset((OP_IF_LT, OP_IF_GT))
+CONDITIONAL_OPS = frozenset(op for op in range(N_OPS) if OP_READS[op] & READS_TARGET)
+
+
+def operands_read(op: int) -> tuple[str, ...]:
+    """The operands op code ``op`` reads (:data:`OP_READS`), in argument order.
+
+    ``"d"`` is its target's old value, ``"a"`` the first operand (``src1``), ``"b"`` the
+    second (``src2``): ``("a", "b")`` for ``add``, ``("b",)`` for ``cos``, ``("d", "a",
+    "b")`` for ``if_lt``. The exported operation functions take these parameters.
+    """
+    reads = int(OP_READS[op])
+    return tuple(
+        name for name, bit in (("d", READS_TARGET), ("a", READS_A), ("b", READS_B)) if reads & bit
+    )
+
 
 #: The read-only constants appended to the private bank (Table 2).
 CONSTANTS = np.array(

@@ -45,6 +45,11 @@ PREFIX = "gym:"
 N_RANDOM_EPISODES = 100
 #: First reset seed of the random-play measurement (the protocol's random-agent base).
 RANDOM_SEED = 2_000_000
+#: First seed of the random player's actions: a stream apart from the resets'. Seeded with
+#: the reset's own seed, the action space drew the same numbers as the environment, so
+#: random play could depend on the episode (a cue drawn by ``reset`` and an action sampled
+#: after it always disagreed: random play read -1 where it is 0).
+RANDOM_ACTION_SEED = 3_000_000
 #: Training episode seeds of the protocol below this are offset by it for a Gymnasium
 #: task, so that ``mtpg evaluate --seed S`` with ``S + k < 10**9`` never replays one.
 TRAIN_RESET_OFFSET = 10**9
@@ -339,7 +344,8 @@ def measure_random(name: str, n: int = N_RANDOM_EPISODES) -> tuple[float, float]
     """Mean and standard deviation of random play on a Gymnasium task.
 
     Episode ``i`` resets with seed ``RANDOM_SEED + i``, and its actions are sampled from
-    the action space seeded with the same seed: a pure function of the name (memoised).
+    the action space seeded with ``RANDOM_ACTION_SEED + i`` (a stream apart from the
+    environment's): a pure function of the name (memoised).
     """
     task = GymTask.from_name(name)
     env = task.make()
@@ -347,7 +353,7 @@ def measure_random(name: str, n: int = N_RANDOM_EPISODES) -> tuple[float, float]
     try:
         for i in range(n):
             env.reset(seed=RANDOM_SEED + i)
-            env.action_space.seed(RANDOM_SEED + i)
+            env.action_space.seed(RANDOM_ACTION_SEED + i)
             total, done = 0.0, False
             while not done:
                 _, reward, terminated, truncated, _ = env.step(env.action_space.sample())

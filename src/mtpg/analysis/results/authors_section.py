@@ -23,6 +23,14 @@ from pathlib import Path
 
 import numpy as np
 
+from mtpg.analysis.results.robust_section import (
+    PAPER_COUNTS,
+    best_run,
+    compared_runs,
+    iqm_rows,
+    normalised_at,
+)
+
 #: The run directories of TPG-authors: ``TPG-authors-seed1`` ...
 PREFIX = "TPG-authors-seed"
 #: Runs a group has when complete.
@@ -71,13 +79,7 @@ class Authors:
     @property
     def best(self):
         """The best compared run: highest worst-task score, then highest mean."""
-        return max(
-            self.compared,
-            key=lambda r: (
-                min(self.norm[r.name].values()),
-                float(np.mean([*self.norm[r.name].values()])),
-            ),
-        )
+        return best_run(self.compared, self.norm)
 
 
 def _by_base(scores: dict[str, float]) -> dict[str, float]:
@@ -92,8 +94,6 @@ def gather(runs, tasks: list[str], target: int) -> Authors:
         tasks: The page's task order (base names).
         target: The generations every run grows to.
     """
-    from mtpg.analysis.results.robust_section import compared_runs, normalised_at
-
     compared, gen = compared_runs(runs, target)
     single = {
         t: max(float(r.row(t, gen)[f"test_{t}"]) for r in compared) for t in compared[0].tasks
@@ -143,19 +143,12 @@ def verdict(rows: list[list[str]]) -> str:
 
 def _claims(c, a: Authors) -> list[list[str]]:
     """The paper's claims, and how many runs of each group meet them."""
-    from mtpg.analysis.results.robust_section import PAPER_COUNTS
 
     def rate(hit: int, n: int, paper: float) -> str:
         return f"{hit} of {n}: " + ("holds" if n and hit / n >= paper else "does not hold")
 
-    best_rob = max(
-        c.groups["TPG-robust"],
-        key=lambda r: (min(c.norm[r.name].values()), float(np.mean([*c.norm[r.name].values()]))),
-    )
-    best_tpg = max(
-        c.groups["TPG"],
-        key=lambda r: (min(c.norm[r.name].values()), float(np.mean([*c.norm[r.name].values()]))),
-    )
+    best_rob = best_run(c.groups["TPG-robust"], c.norm)
+    best_tpg = best_run(c.groups["TPG"], c.norm)
 
     def high(scores: dict[str, float]) -> str:
         k = sum(v >= 0.9 for v in scores.values())
@@ -210,7 +203,6 @@ def section(c, a: Authors, probes: dict, target: int) -> list[str]:
         target: The generations every run grows to.
     """
     from mtpg.analysis.results.memorisation_page import all_task_rows
-    from mtpg.analysis.results.robust_section import iqm_rows
     from mtpg.analysis.results.tables import (
         PAPER,
         cpu_seconds_per_generation,

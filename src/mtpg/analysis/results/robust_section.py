@@ -107,6 +107,13 @@ def _runs(n: int) -> str:
     return f"{n} run" if n == 1 else f"{n} runs"
 
 
+def best_run(runs, norm: dict[str, dict[str, float]]):
+    """The group's best run: highest worst-task score, then highest mean (``norm`` by name)."""
+    return max(
+        runs, key=lambda r: (min(norm[r.name].values()), float(np.mean([*norm[r.name].values()])))
+    )
+
+
 def iqm_rows(estimates: dict[str, tuple[list, object]]) -> list[list[str]]:
     """IQM [95% CI] per task and over all tasks, one row per group (``Comparison.estimates``)."""
     return [
@@ -219,10 +226,7 @@ def answer(c: Comparison) -> list[str]:
     r06, r09 = c.count("TPG-robust", 0.6), c.count("TPG-robust", 0.9)
     yes = 2 * r06 >= n_rob and 10 * r09 >= n_rob
     apart = "the intervals apart" if rob.low > tpg.high else "the intervals overlap"
-    best = max(
-        c.groups["TPG-robust"],
-        key=lambda r: (min(c.norm[r.name].values()), float(np.mean([*c.norm[r.name].values()]))),
-    )
+    best = best_run(c.groups["TPG-robust"], c.norm)
     scores = c.norm[best.name]
     high = [t for t in c.tasks if scores[t] >= 0.9]
     low = [t for t in c.tasks if scores[t] < 0.9]

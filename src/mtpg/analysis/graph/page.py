@@ -58,7 +58,8 @@ def _no_velocity(task: str) -> str | None:
 def default_decompose_task(tasks: list[str]) -> str | None:
     """Pendulum when analysed (the paper's Fig. 10a), else the first task with a hidden state.
 
-    None when every task is a Gymnasium task (:data:`HIDDEN_STATE_NOTE`).
+    None when no task names a hidden velocity (every task is a Gymnasium task or a
+    compiled task of a user's module: :func:`not_applicable`).
     """
     if "Pendulum" in tasks:
         return "Pendulum"
@@ -226,7 +227,7 @@ class _Analysis:
             "visit_rate": {
                 f"team {n}": float(v) for n, v in zip(visits["teams"], rates, strict=True)
             },
-            **({"not_applicable": _no_velocity(task)} if _no_velocity(task) else {}),
+            **({"not_applicable": why} if (why := _no_velocity(task)) else {}),
         }
 
     def decomposition_figure(self, task: str) -> None:

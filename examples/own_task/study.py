@@ -211,6 +211,7 @@ def plot(records: dict, path: Path) -> None:
                 ax.plot(x, y, color=colour, alpha=0.8, lw=1.2, label=side if n == 0 else None)
         ax.set_title(arm[0], fontsize=10)
         ax.set_xlabel("environment steps of training")
+        ax.xaxis.set_major_formatter(lambda v, _: f"{v / 1000:.0f}k")  # labels that fit
         ax.set_ylabel("best training return")
         ax.legend(fontsize=8)
     fig.suptitle("mtpg and pytpg 0.6 at equal environment steps (one line per seed)")

@@ -3,7 +3,8 @@
 ``grow_results_commands.json`` holds the ``mtpg train`` command line of every run of every
 plan as ``tools/grow_results.py`` gave it when its plans were constants of the script
 (written from that script, commit deabae2, before the plans became ``results/plan.toml``):
-every committed run must be begun, and so grown, exactly as it was.
+every committed run must be begun, and so grown, exactly as it was. Groups added to the plan
+after that commit (``episodes6``) were appended to the file as they were begun.
 """
 
 import json

@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import importlib
+import importlib.util
 import re
 import statistics
 import subprocess
@@ -51,7 +52,14 @@ def import_commit(rev: str, folder: Path):
         text = re.sub(r"\bfrom mtpg import\b", "from mtpg_rev import", text)
         text = re.sub(r"^import mtpg$", "import mtpg_rev", text, flags=re.M)
         path.write_text(text)
-    sys.path.insert(0, str(folder))
+    # imported from its folder by a spec, so that sys.path stays as it was; its
+    # submodules are then found through the package's own __path__
+    spec = importlib.util.spec_from_file_location(
+        "mtpg_rev", package / "__init__.py", submodule_search_locations=[str(package)]
+    )
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["mtpg_rev"] = module
+    spec.loader.exec_module(module)
     return "mtpg_rev"
 
 

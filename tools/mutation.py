@@ -148,7 +148,6 @@ def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
     args = ["-q", "-x", "-p", "no:cacheprovider", *(tests or MODULES[module][1])]
     script = (
         "import json, os, signal, sys\n"
-        "sys.path.insert(0, 'src')\n"
         "import pytest, mtpg.evolve.trainer, mtpg.engine.batch\n"
         "from mutmut.mutation.trampoline import set_mutant_under_test\n"
         "names, args = json.loads(sys.argv[1]), json.loads(sys.argv[2])\n"
@@ -165,7 +164,7 @@ def recheck(module: str, tests: list[str], names: list[str]) -> dict[str, str]:
     )
     verdicts = {}
     env = dict(os.environ)
-    env.pop("PYTHONPATH", None)
+    env["PYTHONPATH"] = "src"  # the mutants' copy of the package, not the installed one
     proc = subprocess.Popen(
         [PYTHON, "-c", script, json.dumps(todo), json.dumps(args)],
         cwd=work / "mutants",

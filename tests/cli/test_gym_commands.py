@@ -68,9 +68,9 @@ def runs(tmp_path_factory):
             text=True,
         )
         assert done.returncode == 0, done.stderr
-    sys.path.insert(0, str(folder))  # in-process commands import the user's module too
-    yield root / "cp", root / "line", env
-    sys.path.remove(str(folder))
+    with pytest.MonkeyPatch.context() as patch:  # in-process commands import it too
+        patch.syspath_prepend(str(folder))
+        yield root / "cp", root / "line", env
 
 
 def one_error_line(err: str, command: str) -> str:

@@ -21,6 +21,7 @@ from mtpg.analysis.results.audit import (
     audit_run,
     write_doc,
 )
+from mtpg.analysis.results.audit_trial import write_trial
 
 _LOG = logging.getLogger(__name__)
 
@@ -237,4 +238,5 @@ def write(
     if source != page and source.is_file():
         page.write_text(source.read_text(encoding="utf-8"), encoding="utf-8")
     write_doc(page, block)
+    write_trial(results, page)  # the demo-scale test of the recommendation, stored scores
     return page

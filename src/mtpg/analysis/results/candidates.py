@@ -30,7 +30,16 @@ from mtpg.analysis.runs.statistics import aggregate_iqm, per_task_iqm, probabili
 _LOG = logging.getLogger(__name__)
 #: The study's folder inside the results folder.
 FOLDER = "candidates"
-GROUPS = {"demo": "demo-seed", "demo-resample10": "demo-resample10-seed"}
+#: Each group by the prefix of its run folders: the two candidates, and the robust audit's
+#: test of them (docs/robust-audit.md: resampling with 6 training episodes instead of 3).
+GROUPS = {
+    "demo": "demo-seed",
+    "demo-resample10": "demo-resample10-seed",
+    "demo-resample10-train6": "demo-resample10-train6-seed",
+}
+#: The comparisons the table states, ``(a, b)``: the probability that a run of ``a``
+#: beats one of ``b`` on a task.
+PAIRS = (("demo-resample10", "demo"), ("demo-resample10-train6", "demo-resample10"))
 EPISODES = 100
 BEGIN, END = "<!-- candidates table: begin -->", "<!-- candidates table: end -->"
 
@@ -72,9 +81,10 @@ def table(results: dict[str, dict[str, dict[str, float]]]) -> str:
     for group, m in matrices.items():
         per = " | ".join(e.text() for e in per_task_iqm(m))
         lines.append(f"| {group} | {len(m)} | {aggregate_iqm(m).text()} | {per} |")
-    if all(len(m) for m in matrices.values()) and len(matrices) == 2:
-        a, b = matrices["demo-resample10"], matrices["demo"]
-        lines += ["", f"P(demo-resample10 > demo) = {probability_of_improvement(a, b).text()}"]
+    for a, b in PAIRS:
+        if a in matrices and b in matrices:
+            p = probability_of_improvement(matrices[a], matrices[b])
+            lines += ["", f"P({a} > {b}) = {p.text()}"]
     return "\n".join(lines)
 
 
@@ -106,8 +116,10 @@ def write(results: Path, out: Path | None = None) -> Path:
     scored: dict[str, dict[str, dict[str, float]]] = {}
     for group, prefix in GROUPS.items():
         runs = sorted(p for p in (folder / "runs").glob(f"{prefix}[0-9]*") if p.is_dir())
-        scored[group] = {r.name: scores(r) for r in runs if finished(r)}
-        _LOG.info(f"{group}: {len(scored[group])} of {len(runs)} runs finished")
+        done = {r.name: scores(r) for r in runs if finished(r)}
+        _LOG.info(f"{group}: {len(done)} of {len(runs)} runs finished")
+        if done:  # a group none of whose runs has finished is left out of the table
+            scored[group] = done
     if not any(scored.values()):
         raise ValueError(f"{folder / 'runs'}: no finished run")
     where = (results if out is None else out) / FOLDER

@@ -306,6 +306,8 @@ def test_tpg_authors_joins_tpg_and_tpg_robust_in_a_three_group_section(results, 
     assert "P(TPG-authors > TPG) = " in section and "P(TPG-authors > TPG-robust) = " in section
     assert "| claim (paper) | TPG: its text |" in section
     assert "| TPG-authors-seed1 | 2 | " in section  # re-scores and the probe
+    assert "](figures/three_groups.png)" in section  # the section's table, drawn
+    assert (folder / "figures" / "three_groups.png").stat().st_size > 10_000
     assert "| TPG-authors-seed1 | TPG-authors | 1 | 2 of 1000 (growing) |" in text
     # the paper's experiment's re-score table keeps to the runs of its tasks
     assert "TPG-authors-seed1 | 2 | " not in text[: text.index("## The three groups")]

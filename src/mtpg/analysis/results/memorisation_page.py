@@ -13,6 +13,7 @@ writes nothing into them.
 
 from __future__ import annotations
 
+import re
 import statistics
 from pathlib import Path
 
@@ -38,6 +39,10 @@ ISSUE = {
 ISSUE_REDRAWS = 200
 #: The run whose probe is shown as printed.
 EXAMPLE = "TPG-seed1"
+#: The runs the page probes: the paper's experiment (the ``paper`` group of
+#: ``results/plan.toml``: TPG and its ablations). TPG-robust and TPG-authors are probed on
+#: the results page, beside their groups (TPG-authors plays other task variants).
+PAPER_RUN = re.compile(r"TPG-(No[A-Za-z]+-)?seed\d+")
 #: Single-task champions probed besides the all-task ones.
 SINGLE_TASKS = ("CartCentering", "Pendulum")
 
@@ -150,7 +155,11 @@ def summary(probes: dict[str, Probe]) -> list[str]:
 
 def block(results: Path) -> list[str]:
     """The generated section."""
-    runs = sorted(p for p in (results / "runs").iterdir() if (p / "config.toml").is_file())
+    runs = sorted(
+        p
+        for p in (results / "runs").iterdir()
+        if (p / "config.toml").is_file() and PAPER_RUN.fullmatch(p.name)
+    )
     probes = {run.name: probe_target(run) for run in runs}
     first = next(iter(probes.values()))
     head, rows = all_task_rows(probes)

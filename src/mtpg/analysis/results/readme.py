@@ -101,6 +101,21 @@ def _robust_figure(comparison, tpg, numbers, path: Path) -> Path:
     return aggregate(groups, drawn, comparison.estimates, path)
 
 
+def _three_figure(comparison, tpg, numbers, three, path: Path) -> Path:
+    """The three groups' IQM per task and over all tasks (the authors section's table)."""
+    from mtpg.analysis.runs import statistics as stats
+    from mtpg.analysis.runs.loading import RunGroup
+    from mtpg.analysis.runs.reported_numbers import run_numbers
+    from mtpg.analysis.runs.statistics_figures import aggregate
+
+    robust = comparison.groups["TPG-robust"]
+    groups = [tpg, RunGroup("TPG-robust", robust, {}), RunGroup("TPG-authors", three.compared, {})]
+    drawn = {**numbers, **{r.path: run_numbers(r) for r in [*robust, *three.compared]}}
+    estimates = dict(comparison.estimates)
+    estimates["TPG-authors"] = (stats.per_task_iqm(three.matrix), stats.aggregate_iqm(three.matrix))
+    return aggregate(groups, drawn, estimates, path)
+
+
 def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | None = None) -> Path:
     """Writes the figures and ``README.md`` of ``results``; returns the README's path.
 
@@ -335,6 +350,9 @@ def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | N
 
             probes = {r.name: probe_target(r.path) for r in authors}
         lines += authors_section(comparison, three, probes, TARGET)
+        _three_figure(comparison, tpg, numbers, three, figures / "three_groups.png")
+        caption = "TPG, TPG-robust and TPG-authors: IQM with 95% CIs (TPG-authors on its variants)"
+        lines.append(_fig("three_groups.png", caption))
     lines += ["## Cost", ""]
     lines += [
         "Wall-clock hours: the sum of `metrics.csv`'s `t_total` (every generation, test "

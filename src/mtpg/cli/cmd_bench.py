@@ -96,6 +96,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     tasks.add_argument("--repeats", type=int, default=3, help="rounds, median reported (3)")
     tasks.add_argument("--seed", type=int, default=1, help="run seed (1)")
     tasks.set_defaults(func=_run_tasks)
+    lanes = sub.add_parser(
+        "lanes",
+        help="the lane engine against the scalar kernel on every workload, with page faults",
+        description=(
+            "Plays each workload with the scalar kernel and with the lane engine, in "
+            "interleaved rounds, and checks that every job has the same outcome in both: the "
+            "random CartPole graphs of `mtpg bench engine`, a demo population at generation "
+            "1 on all six tasks, and with --late RUN_DIR every root of that run's last "
+            "checkpoint. One thread is timed by process CPU time, more by wall time; the "
+            "process's minor page faults during each call are counted. Prints a table, "
+            "then one JSON object as the last line (mtpg.bench.lanes_bench)."
+        ),
+    )
+    lanes.add_argument("--late", metavar="RUN_DIR", help="a run for the late workload (none)")
+    lanes.add_argument("--graphs", type=int, default=3000, help="graphs of the engine workload")
+    lanes.add_argument("--threads", default="1,2", help="thread counts, comma-separated (1,2)")
+    lanes.add_argument("--repeats", type=int, default=3, help="rounds, medians reported (3)")
+    lanes.add_argument("--lanes", type=int, default=32, help="lane-block size (32)")
+    lanes.set_defaults(func=_run_lanes)
     bench.set_defaults(func=lambda _args: _help(bench))
 
 
@@ -124,6 +143,36 @@ def _run_tasks(args: argparse.Namespace) -> int:
         print(f"  {label:<20} {arm['decisions_per_s']:>12,.0f} decisions/s  ({arm['task']})")
     same = "identical runs" if r["compiled_run_identical_decisions"] else "runs differ"
     print(f"  compiled / built-in  {r['compiled_vs_built_in']:.2f}  ({same})")
+    print(json.dumps(r))
+    return 0
+
+
+def _run_lanes(args: argparse.Namespace) -> int:
+    """``mtpg bench lanes``: prints the table and the JSON line."""
+    from mtpg.bench.engine import machine_info
+    from mtpg.bench.lanes_bench import lanes_benchmark
+
+    try:
+        threads = [int(t) for t in args.threads.split(",")]
+        r = lanes_benchmark(args.late, args.graphs, args.repeats, threads, args.lanes, None)
+    except (OSError, ValueError, RuntimeError) as exc:  # bad input, or the engines disagree
+        raise SystemExit(f"mtpg bench lanes: {exc}") from None
+    m = machine_info()
+    r["machine"] = m
+    print(f"lane engine ({r['lanes']} lanes) against the scalar kernel ({m['cpu']})")
+    print(
+        "| workload | threads | clock | decisions | scalar decisions/s | lanes decisions/s"
+        " | lanes / scalar | page faults scalar / lanes |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    for row in r["rows"]:
+        faults = f"{_fmt(row['scalar_page_faults'])} / {_fmt(row['lanes_page_faults'])}"
+        print(
+            f"| {row['workload']} | {row['threads']} | {row['clock']} | {row['decisions']:,} |"
+            f" {_fmt(row['scalar_decisions_per_s'])} | {_fmt(row['lanes_decisions_per_s'])} |"
+            f" {row['lanes_vs_scalar']:.2f} | {faults} |"
+        )
+    print(f"(median of {r['repeats']} interleaved rounds; every job identical in both)")
     print(json.dumps(r))
     return 0
 

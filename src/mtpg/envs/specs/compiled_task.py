@@ -17,7 +17,8 @@ in an importable module, naming three functions and the task's sizes::
   (``rng`` is the episode's ``numpy.random.Generator``, seeded by the episode's seed; the
   draws it makes are the task's business).
 - ``p`` is the task's parameter row: ``p[0]`` the time limit, ``p[1]`` the bound of the
-  continuous action, ``p[2:]`` the ``params`` given (at most :data:`MAX_PARAMS`).
+  continuous action (``action_bound``; a task without a continuous action may read it as
+  a constant of its own), ``p[2:]`` the ``params`` given (at most :data:`MAX_PARAMS`).
 - ``obs`` has at least ``n_obs`` slots; write values in about ``[-1, 1]`` (the programs'
   range; nothing is rescaled). ``noise`` is a U[0, 1] value drawn for this step from the
   episode's seed, for tasks that observe noise.
@@ -31,10 +32,12 @@ in an importable module, naming three functions and the task's sizes::
   sample_start(rng)``, then ``noise = rng.random(max_steps + 1)`` (``noise[t]`` observed
   after ``t`` steps), so a plain loop calling the task's functions replays any episode.
 
-The six registered tasks hold the same three roles in their modules
-(:class:`~mtpg.envs.specs.task_spec.TaskSpec` names them); their dispatch is compiled once and
-cached, while a compiled task's is generated for the run's task set and compiled in each
-process (:mod:`mtpg.envs.dynamics.user_dispatch`), which takes some seconds.
+The six registered tasks are this contract's first users: ``mtpg.envs.dynamics.builtin_compiled``
+writes each as a :class:`CompiledTask` from its own module's kernels, and a run on them
+equals the run on the registered tasks bit for bit. A run naming the registered tasks
+still uses their dispatch, compiled once and cached, while a compiled task's is generated
+for the run's task set and compiled in each process (:mod:`mtpg.envs.dynamics.user_dispatch`),
+which takes some seconds: Numba caches by source file, and generated code has none.
 """
 
 from __future__ import annotations
@@ -81,7 +84,8 @@ class CompiledTask:
         state_dim: Slots of the task's state.
         max_steps: The time limit in steps.
         params: The task's constants, ``p[2:]`` (at most :data:`MAX_PARAMS`).
-        action_bound: The bound of the continuous action, ``p[1]``.
+        action_bound: The bound of the continuous action, ``p[1]`` (a constant the task
+            may read when it has no continuous action).
         noise_input: Whether ``observe`` reads ``noise`` (the memorisation probe then
             redraws it, as for the registered tasks' noise input).
         name: Set by :func:`load`: ``module:ATTR``.

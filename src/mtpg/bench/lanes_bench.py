@@ -26,14 +26,15 @@ The ``resource`` module is POSIX only; on Windows the faults are reported as ``N
 from __future__ import annotations
 
 import statistics
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
+from mtpg.bench.late import late_workload, population_workload
 from mtpg.bench.workload import Workload, drive, make_workload
 from mtpg.engine.batch import Episodes
-from mtpg.engine.compile import compile_population
 from mtpg.engine.lanes import DEFAULT_LANES
 
 try:
@@ -67,24 +68,7 @@ def first_generation_workload(preset: str = "demo", seed: int = 0) -> Workload:
     pool = Episodes.grid(
         list(table.ids), resampled_training_seeds(seed, 0, ev.train_episodes), table
     )
-    cp = compile_population(pop)
-    root_ids = list(pop.roots())
-    roots = np.array([cp.team_index(r) for r in root_ids], dtype=np.int64)
-    n_ep = len(pool.tasks)
-    return Workload(
-        pop=pop,
-        root_ids=root_ids,
-        cp=cp,
-        pool=pool,
-        job_roots=np.repeat(roots, n_ep),
-        job_episodes=np.tile(np.arange(n_ep, dtype=np.int64), len(roots)),
-        episodes=n_ep,
-        teams=len(pop.teams),
-        programs=len(pop.programs),
-        instructions=int(cp.n_instructions.sum()),
-        pointer_fraction=float(np.mean(cp.graph.prog_action >= 0)),
-        build_seconds=0.0,
-    )
+    return population_workload(pop, pool, time.perf_counter())
 
 
 def _timed(work: Workload, threads: int, lanes: int):
@@ -161,8 +145,6 @@ def lanes_benchmark(
         ``{"lanes": lanes, "repeats": repeats, "rows": [...]}``, a row per workload and
         thread count (:func:`compare`'s figures and the workload's name).
     """
-    from mtpg.bench.late import late_workload
-
     say = log or (lambda _msg: None)
     if repeats < 1 or lanes < 1 or not threads or min(threads) < 1:
         raise ValueError("need repeats >= 1, lanes >= 1 and thread counts >= 1")

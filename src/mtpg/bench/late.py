@@ -24,6 +24,34 @@ from mtpg.engine.compile import compile_population
 from mtpg.engine.lanes import DEFAULT_LANES
 
 
+def population_workload(pop, pool: Episodes, t0: float) -> Workload:
+    """Every root of ``pop`` on every episode of ``pool``, one root's episodes per block.
+
+    Args:
+        pop: The population (compiled here, as training compiles it).
+        pool: The episodes each root plays.
+        t0: ``time.perf_counter()`` when building began (for ``build_seconds``).
+    """
+    cp = compile_population(pop)
+    root_ids = list(pop.roots())
+    n_ep = len(pool.tasks)
+    roots = np.array([cp.team_index(r) for r in root_ids], dtype=np.int64)
+    return Workload(
+        pop=pop,
+        root_ids=root_ids,
+        cp=cp,
+        pool=pool,
+        job_roots=np.repeat(roots, n_ep),
+        job_episodes=np.tile(np.arange(n_ep, dtype=np.int64), len(roots)),
+        episodes=n_ep,
+        teams=len(pop.teams),
+        programs=len(pop.programs),
+        instructions=int(cp.n_instructions.sum()),
+        pointer_fraction=float(np.mean(cp.graph.prog_action >= 0)),
+        build_seconds=time.perf_counter() - t0,
+    )
+
+
 def late_workload(run_dir: str | Path) -> tuple[Workload, int]:
     """Every root of a run's last checkpoint on the run's training episodes.
 
@@ -49,24 +77,7 @@ def late_workload(run_dir: str | Path) -> tuple[Workload, int]:
     seeds = resampled_training_seeds(config.seed, 0, ev.train_episodes)
     table = ev.task_table()
     pool = Episodes.grid(list(table.ids), seeds, table)
-    cp = compile_population(state.population)
-    root_ids = list(state.population.roots())
-    n_ep = len(pool.tasks)
-    roots = np.array([cp.team_index(r) for r in root_ids], dtype=np.int64)
-    work = Workload(
-        pop=state.population,
-        root_ids=root_ids,
-        cp=cp,
-        pool=pool,
-        job_roots=np.repeat(roots, n_ep),
-        job_episodes=np.tile(np.arange(n_ep, dtype=np.int64), len(roots)),
-        episodes=n_ep,
-        teams=len(state.population.teams),
-        programs=len(state.population.programs),
-        instructions=int(cp.n_instructions.sum()),
-        pointer_fraction=float(np.mean(cp.graph.prog_action >= 0)),
-        build_seconds=time.perf_counter() - t0,
-    )
+    work = population_workload(state.population, pool, t0)
     return work, state.generation
 
 

@@ -234,16 +234,7 @@ def compile_population(
     lengths = np.array([len(b) for b in blocks], dtype=np.int64)
     code = np.concatenate(blocks) if blocks else np.zeros((0, 4), np.int32)
     mem_base = r + N_CONSTANTS + layout.n_obs + len(pool)
-    bank_per_instr = np.repeat(prog_bank, lengths)[:, None]
-    operands = code[:, 1:].astype(np.int64)
-    mapped = np.where(
-        operands < r,
-        operands,
-        np.where(operands < r + m, mem_base + bank_per_instr * m + operands - r, operands - m),
-    )
-    instrs = np.empty_like(code, dtype=np.uint32)
-    instrs[:, 0] = code[:, 0]
-    instrs[:, 1:] = mapped
+    instrs = _workspace_code(code, np.repeat(prog_bank, lengths), r, m, mem_base)
     graph = Graph(
         team_offsets=np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
         team_members=team_members.astype(np.int64),
@@ -267,6 +258,29 @@ def compile_population(
         n_instructions=np.array([len(p.instructions) for p in progs], dtype=np.int64),
         folded=fold,
     )
+
+
+def _workspace_code(
+    code: np.ndarray, bank_per_instr: np.ndarray, r: int, m: int, mem_base: int
+) -> np.ndarray:
+    """The instructions with their operands as workspace indices (uint32 ``(n, 4)``).
+
+    Logical operands (registers ``r``, then memory ``m``, then constants, inputs and
+    folded constants) map to the workspace of :mod:`mtpg.engine.compile`: a register
+    stays, memory register ``j`` of an instruction goes to its program's bank
+    (``mem_base + bank * m + j``), and the rest move down by ``m`` (the banks sit last).
+    """
+    operands = code[:, 1:].astype(np.int64)
+    bank = bank_per_instr[:, None]
+    mapped = np.where(
+        operands < r,
+        operands,
+        np.where(operands < r + m, mem_base + bank * m + operands - r, operands - m),
+    )
+    instrs = np.empty_like(code, dtype=np.uint32)
+    instrs[:, 0] = code[:, 0]
+    instrs[:, 1:] = mapped
+    return instrs
 
 
 def _fold_blocks(

@@ -6,13 +6,17 @@ compiled graph (:class:`~mtpg.engine.compile.Graph`), the jobs and the episode t
 (:class:`~mtpg.engine.batch.BatchResult`) and one thread's private :class:`Buffers`, whose
 float64 workspace ``W`` is laid out as documented in :mod:`mtpg.engine.compile`.
 
-The scalar decision semantics live in :func:`decide_bank` alone (:func:`decide` reads its
-continuous output) and the scalar episode loop
-in :func:`run_jobs_queue` alone (the lane engine, :mod:`mtpg.engine.lanes`, plays many
-episodes at once and is tested to match them job by job): the tracer
-(:mod:`mtpg.engine.trace`) runs the same two with
-a :class:`~mtpg.engine.record.Recorder`, and the training path passes ``rec=None``, with
-which Numba compiles every recording branch out.
+This is the scalar engine: one episode at a time. Training, test points, ``evaluate`` and
+``probe`` play the lane engine (:mod:`mtpg.engine.lanes`, many episodes of a root in
+lockstep, its decision in :mod:`mtpg.engine.lane_decide`), which is tested to match this
+kernel job by job; ``replay``, ``trace`` and ``analyze`` (:mod:`mtpg.engine.trace`), live
+decisions (:mod:`mtpg.engine.live`, :mod:`mtpg.engine.live_trace`) and
+``run_jobs(..., lanes=0)`` play this one. Both engines compare bids with the one rule,
+:func:`mtpg.engine.bid_rule.takes_lead`, inlined. The scalar decision lives in
+:func:`decide_bank` alone (:func:`decide` reads its continuous output) and the scalar
+episode loop in :func:`run_jobs_queue` alone: the tracer runs the same two with a
+:class:`~mtpg.engine.record.Recorder`, and the batch path passes ``rec=None``, with which
+Numba compiles every recording branch out.
 
 Memory banks are reset lazily: ``bank_stamp[b]`` records the episode in which bank ``b``
 was last zeroed, and a program zeroes its bank before running when the stamp is stale.
@@ -29,6 +33,7 @@ from numba import njit, prange, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from mtpg.engine.bid_rule import NO_BID, takes_lead
 from mtpg.engine.ops import apply_op
 from mtpg.engine.record import (
     record_decision,
@@ -138,13 +143,17 @@ def decide_bank(g, buf, root, stamp, episode, rec):
 
     Written as one flat loop nest on purpose: helper functions taking arrays cost an
     atomic reference-count update per call, about a fifth of the run time. It is inlined
-    into its callers (``inline="always"``, as is ``apply_op``), so a decision passes no
-    arguments (each array is seven machine words) and the instruction loop is compiled
-    in place.
+    into its callers (``inline="always"``, as are ``apply_op`` and ``takes_lead``), so a
+    decision passes no arguments (each array is seven machine words) and the instruction
+    loop is compiled in place. Every index is unsigned (``np.uint64``): Numba then emits
+    plain loads and stores, without the fix-up for negative (from-the-end) indices that a
+    signed index costs at every access (and that turned the bank reset into scatter
+    stores).
 
-    Each visited team runs all its programs in order, then follows the highest bid among
-    programs whose pointer is atomic or leads to a team not yet visited in this decision
-    (ties go to the earlier program).
+    Each visited team runs all its programs in order, then follows the winner of the
+    engine's one bid rule, :func:`~mtpg.engine.bid_rule.takes_lead` (the highest bid among
+    programs whose pointer is atomic or leads to a team not yet visited in this decision;
+    ties go to the earlier program), the lane engine's rule too.
 
     Args:
         g: The compiled graph (:class:`~mtpg.engine.compile.Graph`).
@@ -163,9 +172,6 @@ def decide_bank(g, buf, root, stamp, episode, rec):
     R, M, base = g.n_registers, g.n_memory, g.mem_base
     no_memory = g.no_memory  # the ablation: every bank zeroed before each program run
     W, team_stamp, bank_stamp, counts = buf.W, buf.team_stamp, buf.bank_stamp, buf.counts
-    # Every index below is unsigned (np.uint64): Numba then emits plain loads and stores,
-    # without the fix-up for negative (from-the-end) indices that a signed index costs at
-    # every access (and that turned the bank reset into scatter stores).
     one = np.uint64(1)
     u_m = np.uint64(M)
     u_base = np.uint64(base)
@@ -177,10 +183,8 @@ def decide_bank(g, buf, root, stamp, episode, rec):
         n_teams += 1
         if rec is not None:
             record_team(rec, team)
-        # No eligible program yet: -1, a sentinel as in the C yardstick. A separate `found`
-        # flag cost LLVM registers it then spilled (about 3% more instructions per pass).
-        best_p = -1
-        best = 0.0
+        best_p = -1  # set by the first eligible program (every team has an atomic one)
+        best = NO_BID
         for k in range(np.uint64(team_offsets[team]), np.uint64(team_offsets[team + one])):
             p = np.uint64(team_members[k])
             bank = np.uint64(prog_bank[p])
@@ -211,7 +215,7 @@ def decide_bank(g, buf, root, stamp, episode, rec):
             if rec is not None:
                 record_program(rec, p, bid)
             act = prog_action[p]
-            if (act < 0 or team_stamp[np.uint64(act)] != stamp) and (best_p < 0 or bid > best):
+            if takes_lead(act, team_stamp, np.uint64(act), stamp, bid, best):
                 best = bid
                 best_p = np.int64(p)
         act = prog_action[np.uint64(best_p)]

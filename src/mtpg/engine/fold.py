@@ -61,6 +61,17 @@ def _operand(x, known, is_known, constants, first_const):
     return False, 0.0  # the observation: known only when the program runs
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _copy_row(out, n_out, dst, values, n_val, value, first_folded):
+    """Writes row ``n_out`` of ``out``: a copy of pool value ``n_val`` into ``dst``.
+
+    The row is one :data:`OP_COPY`; the pool value ``values[n_val]`` is set to ``value``.
+    """
+    values[n_val] = value
+    out[n_out, 0], out[n_out, 1], out[n_out, 2] = OP_COPY, dst, dst
+    out[n_out, 3] = first_folded + n_val
+
+
 @njit(cache=True, error_model="numpy")
 def _fold_kernel(code, n_r, first_const, constants, first_folded):
     """Folds one program's effective ``code`` (logical operands); see the module docstring.
@@ -96,9 +107,7 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
             is_known[dst] = True
             if dst < n_r:
                 continue
-            values[n_val] = v  # memory: the value must be written
-            out[n_out, 0], out[n_out, 1], out[n_out, 2] = OP_COPY, dst, dst
-            out[n_out, 3] = first_folded + n_val
+            _copy_row(out, n_out, dst, values, n_val, v, first_folded)  # memory: written
             n_val += 1
             n_out += 1
             continue
@@ -106,9 +115,7 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
             continue  # a condition known to be false (1 not negated): changes nothing
         # Executed: reads of known private registers go to the pool instead.
         if cond and dst < n_r and is_known[dst]:
-            values[n_val] = known[dst]
-            out[n_out, 0], out[n_out, 1], out[n_out, 2] = OP_COPY, dst, dst
-            out[n_out, 3] = first_folded + n_val
+            _copy_row(out, n_out, dst, values, n_val, known[dst], first_folded)
             n_val += 1
             n_out += 1
         if reads_a and a < n_r and is_known[a]:
@@ -126,9 +133,7 @@ def _fold_kernel(code, n_r, first_const, constants, first_folded):
             r0_written = True
     # The bid: r[0] must hold its value's bits (a zeroed register holds +0.0).
     if is_known[0] and (r0_written or known[0] != 0.0 or math.copysign(1.0, known[0]) < 0.0):
-        values[n_val] = known[0]
-        out[n_out, 0], out[n_out, 1], out[n_out, 2] = OP_COPY, 0, 0
-        out[n_out, 3] = first_folded + n_val
+        _copy_row(out, n_out, 0, values, n_val, known[0], first_folded)
         n_val += 1
         n_out += 1
     return out[:n_out].copy(), values[:n_val].copy()

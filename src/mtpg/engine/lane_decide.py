@@ -5,8 +5,10 @@ of the team runs once over the group (:func:`run_team`: its bank and registers z
 where the program must see zeros, then its code, one :func:`~mtpg.engine.lane_ops.lane_op`
 per instruction), and each lane keeps its own highest bid under its own visited-team
 rule (:func:`_bid`); then each lane follows its winner (:func:`_follow`) to an atomic
-action or into the group of the next team. The rule is that of
-:func:`mtpg.engine.episode_kernels.decide_bank`, lane by lane (tested job by job).
+action or into the group of the next team. The bid rule is the engine's one,
+:func:`mtpg.engine.bid_rule.takes_lead`, which the scalar kernel
+(:func:`mtpg.engine.episode_kernels.decide_bank`) calls too: each lane decides as the
+scalar kernel does (tested job by job).
 
 Every step is inlined into :func:`decide_lanes` (``inline="always"``), and that into the
 lane engine's loop (:func:`mtpg.engine.lanes.run_lanes_queue`), so the steps cost no
@@ -20,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from mtpg.engine.bid_rule import NO_BID, takes_lead
 from mtpg.engine.lane_graph import P_ACT, P_BANK, P_COUNT, P_HI, P_LBANK, P_LO, P_ZERO
 from mtpg.engine.lane_ops import lane_op
 
@@ -58,7 +61,7 @@ def _enter(lb, u_team, n):
         lane = grp[k]
         visited[u_team * L + lane] = stamp
         n_team[lane] += 1
-        best[lane] = -np.inf
+        best[lane] = NO_BID
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -106,27 +109,27 @@ def _zero_registers(g, lb, row, n):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _bid(lb, row, q, n):
-    """Each lane of the group takes program row ``q`` if it is eligible and bids higher.
+    """Each lane of the group takes program row ``q`` where the engine's bid rule says so.
 
-    Bids are finite, so starting from -inf the first eligible program wins and a later
-    one only with a higher bid (ties: the earlier), as in the scalar kernel; a program
-    pointing to a team the lane visited in this decision is not eligible.
+    The rule is :func:`~mtpg.engine.bid_rule.takes_lead`, with each lane's own best bid
+    (from :data:`~mtpg.engine.bid_rule.NO_BID`, set by :func:`_enter`) and its own visit
+    marks. The atomic case is a loop of its own, so the group's loop reads no visit mark
+    (the rule's ``act < 0`` is known there).
     """
-    W, grp, best, best_p = lb.W, lb.grp, lb.best, lb.best_p
+    W, grp, best, best_p, visited = lb.W, lb.grp, lb.best, lb.best_p, lb.visited
     act = row[P_ACT]
+    stamp = lb.marks[STEP_MARK]
     if act < 0:
         for k in range(n):
             lane = grp[k]
-            if W[lane] > best[lane]:
+            if takes_lead(act, visited, lane, stamp, W[lane], best[lane]):
                 best[lane] = W[lane]
                 best_p[lane] = q
     else:
-        visited = lb.visited
-        stamp = lb.marks[STEP_MARK]
         u_act = np.uint64(act) * np.uint64(len(lb.job))
         for k in range(n):
             lane = grp[k]
-            if visited[u_act + lane] != stamp and W[lane] > best[lane]:
+            if takes_lead(act, visited, u_act + lane, stamp, W[lane], best[lane]):
                 best[lane] = W[lane]
                 best_p[lane] = q
 

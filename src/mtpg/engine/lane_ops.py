@@ -26,9 +26,23 @@ def lane_op(Wf, c, grp, n):
     one value shared by all lanes (``mx = 0``: a constant).
 
     Each loop computes :func:`~mtpg.engine.ops.apply_op`'s value for its op code with the
-    same functions, so the op code is tested once per group, not once per lane.
+    same functions, so the op code is tested once per group, not once per lane. The loops
+    are written in three steps by the operands they read: the binary ops, the unary ops,
+    the conditionals and the copy.
     """
-    op, ud, ua, ma, ub, mb = c[C_OP], c[C_DST], c[C_A], c[C_MA], c[C_B], c[C_MB]
+    op = c[C_OP]
+    if op < 5:
+        _binary(Wf, c, grp, n, op)
+    elif op < 14:
+        _unary(Wf, c, grp, n, op)
+    else:
+        _conditional_or_copy(Wf, c, grp, n, op)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _binary(Wf, c, grp, n, op):
+    """Op codes 0 to 4 (``+ - * / pow``), over the lanes ``grp[:n]``."""
+    ud, ua, ma, ub, mb = c[C_DST], c[C_A], c[C_MA], c[C_B], c[C_MB]
     if op == 0:
         for k in range(n):
             lane = grp[k]
@@ -49,12 +63,17 @@ def lane_op(Wf, c, grp, n):
         for k in range(n):
             lane = grp[k]
             Wf[ud + lane] = _clamp(op_pow(Wf[ua + (lane & ma)], Wf[ub + (lane & mb)]))
-    elif op == 5:
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _unary(Wf, c, grp, n, op):
+    """Op codes 5 to 13 (the unary ops: each reads the second operand only)."""
+    ud, ub, mb = c[C_DST], c[C_B], c[C_MB]
+    if op == 5:
         for k in range(n):
             lane = grp[k]
-            Wf[ud + lane] = op_cos(
-                Wf[ub + (lane & mb)]
-            )  # within [-1, 1]: the clamp changes nothing
+            # within [-1, 1]: the clamp changes nothing
+            Wf[ud + lane] = op_cos(Wf[ub + (lane & mb)])
     elif op == 6:
         for k in range(n):
             lane = grp[k]
@@ -89,7 +108,13 @@ def lane_op(Wf, c, grp, n):
             lane = grp[k]
             b = Wf[ub + (lane & mb)]
             Wf[ud + lane] = _clamp(b * b * b)
-    elif op == 14:
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _conditional_or_copy(Wf, c, grp, n, op):
+    """Op codes 14 and 15 (the conditionals) and the engine's copy."""
+    ud, ua, ma, ub, mb = c[C_DST], c[C_A], c[C_MA], c[C_B], c[C_MB]
+    if op == 14:
         for k in range(n):
             lane = grp[k]
             d = Wf[ud + lane]

@@ -130,20 +130,28 @@ def _program_function(graph: ExportGraph, k: int, prog: ExportProgram) -> str:
     return "\n".join(head + lines + [f"    return {_operand(prog.bid)};", "}"])
 
 
+def _takes_lead(prog: ExportProgram) -> str:
+    """The engine's bid rule (:func:`mtpg.engine.bid_rule.takes_lead`) as a C condition.
+
+    Eligible: atomic, or pointing to a team not visited in this decision; then the first
+    eligible program (``!have``), or a strictly higher bid (ties: the earlier program).
+    """
+    lead = "!have || bid > best"
+    return lead if prog.is_atomic else f"!visited[{prog.target}] && ({lead})"
+
+
 def _team_case(graph: ExportGraph, t: int) -> str:
     lines = [f"        case {t}: /* team {graph.team_ids[t]} */"]
     for k in graph.teams[t]:
         prog = graph.programs[k]
         lines.append(f"            bid = mtpg_p{k}(obs);")
         if prog.is_atomic:
-            cond = "!have || bid > best"
             take = f"next = {prog.target}; bank = {prog.bank};"
             what = f"program {prog.id}: action {-1 - prog.target}"
         else:
-            cond = f"!visited[{prog.target}] && (!have || bid > best)"
             take = f"next = {prog.target};"
             what = f"program {prog.id}: team {graph.team_ids[prog.target]}"
-        lines.append(f"            if ({cond}) {{ /* {what} */")
+        lines.append(f"            if ({_takes_lead(prog)}) {{ /* {what} */")
         lines.append(f"                have = 1; best = bid; {take}")
         lines.append("            }")
     lines.append("            break;")

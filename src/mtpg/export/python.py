@@ -82,6 +82,16 @@ def _program_function(graph: ExportGraph, k: int, prog: ExportProgram) -> str:
     return "\n".join(head + body + [f"    return {_operand(prog.bid)}"])
 
 
+def _takes_lead(prog: ExportProgram) -> str:
+    """The engine's bid rule (:func:`mtpg.engine.bid_rule.takes_lead`) as a condition.
+
+    Eligible: atomic, or pointing to a team not visited in this decision; then the first
+    eligible program (``not have``), or a strictly higher bid (ties: the earlier program).
+    """
+    lead = "not have or bid > best"
+    return lead if prog.is_atomic else f"not visited[{prog.target}] and ({lead})"
+
+
 def _team_function(graph: ExportGraph, t: int) -> str:
     lines = [
         f"def _t{t}(s, visited):",
@@ -92,16 +102,13 @@ def _team_function(graph: ExportGraph, t: int) -> str:
         prog = graph.programs[k]
         lines.append(f"    bid = _p{k}(s)")
         if prog.is_atomic:
-            lines.append(
-                f"    if not have or bid > best:  # program {prog.id}: action {-1 - prog.target}"
-            )
-            lines.append(f"        have, best, nxt, bank = True, bid, {prog.target}, {prog.bank}")
+            what = f"action {-1 - prog.target}"
+            take = f"have, best, nxt, bank = True, bid, {prog.target}, {prog.bank}"
         else:
-            lines.append(
-                f"    if not visited[{prog.target}] and (not have or bid > best):"
-                f"  # program {prog.id}: team {graph.team_ids[prog.target]}"
-            )
-            lines.append(f"        have, best, nxt = True, bid, {prog.target}")
+            what = f"team {graph.team_ids[prog.target]}"
+            take = f"have, best, nxt = True, bid, {prog.target}"
+        lines.append(f"    if {_takes_lead(prog)}:  # program {prog.id}: {what}")
+        lines.append(f"        {take}")
     lines.append("    return nxt, bank")
     return "\n".join(lines)
 

@@ -118,11 +118,16 @@ def test_inputs_a_task_lacks_read_zero_in_a_run_of_several_sizes(user_module):
     cp = compile_population(pop)
     seeds = list(range(30, 36))
     both = Episodes.grid(list(mixed.ids), seeds, mixed)
-    got, _ = evaluate_roots(cp, roots, both)
+    got, done = evaluate_roots(cp, roots, both)
     # CartPole's third input reads 0, whatever the Hold episodes before it observed
     alone, _ = evaluate_roots(cp, roots, Episodes.grid([0], seeds, mixed))
     assert np.array_equal(got[:, : len(seeds)], alone)
     assert np.isfinite(got).all()
+    # the lane engine (the default above) plays three inputs as the scalar loop does
+    scalar, ref = evaluate_roots(cp, roots, both, lanes=0)
+    assert got.tobytes() == scalar.tobytes()
+    for field in ("steps", "teams", "instructions"):
+        assert np.array_equal(getattr(done, field), getattr(ref, field)), field
 
 
 def test_a_compiled_task_trains_resumes_exactly_and_acts_as_a_policy(tmp_path, user_module):

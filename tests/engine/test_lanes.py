@@ -78,12 +78,13 @@ def test_lanes_equal_scalar_on_layered_graphs_and_threads(no_memory, fold):
         _same(got, scalar)
 
 
-def test_lanes_equal_scalar_with_other_register_sizes():
+def test_lanes_equal_scalar_with_other_register_and_input_sizes():
     rng = np.random.default_rng(8)
     layouts = (
         RegisterLayout(n_registers=3, n_memory=2),
         RegisterLayout(n_registers=12),
         RegisterLayout(n_registers=70, n_memory=3),  # above 64: every register zeroed
+        RegisterLayout(n_obs=4),  # inputs the built-in tasks lack read 0 in every lane
     )
     for layout in layouts:
         pop = tangled_population(rng, 5, 20, 25, 4, 0.5, layout)

@@ -252,8 +252,6 @@ def run_jobs(
         queue_kernel, parallel_kernel, lanes_kernel, lanes_parallel = user_kernels(
             episodes.user, USER_ID_BASE, episodes.starts.shape[1]
         )
-        if cp.layout.n_obs != 2:  # the lane engine reads two inputs
-            lanes = 0
         episodes = episodes.plain()
     if threads == 1 and lanes == 0:
         queue_kernel(queue, block, jobs, episodes, out, g)

@@ -61,7 +61,7 @@ class Lanes(NamedTuple):
         W: float64 lane workspace (:mod:`mtpg.engine.lane_graph`: a row per register,
             observation input and bank register, a column per lane; then the constants).
         state: float64 ``[lanes, STATE_SIZE]``: each lane's task state.
-        obs: float64 ``[2]``: one lane's observation as its task writes it.
+        obs: float64 ``[n_obs]``: one lane's observation as its task writes it.
         visited: int64 ``[n_teams * lanes]``: decision mark per local team and lane.
         bank_mark: int64 ``[n_banks]``: block mark of each local bank's last zeroing.
         roots: int64 ``[lanes]``: the block's distinct roots.
@@ -132,7 +132,7 @@ def lane_buffers(g, lanes) -> Lanes:
     return Lanes(
         W=W,
         state=np.zeros((lanes, STATE_SIZE)),
-        obs=np.zeros(2),
+        obs=np.zeros(n_obs),
         visited=np.full(n_teams * lanes, -1, dtype=np.int64),
         bank_mark=np.zeros(max(n_banks, 1), dtype=np.int64),
         roots=np.zeros(lanes, dtype=np.int64),
@@ -154,6 +154,17 @@ def lane_buffers(g, lanes) -> Lanes:
         pend_lane=np.zeros(lanes, dtype=np.int64),
         grp=np.zeros(lanes, dtype=np.uint64),
     )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _write_obs(W, obs, at, L):
+    """Writes the observation ``obs`` into a lane's column: input ``i`` at ``at + i * L``.
+
+    ``obs`` has the layout's ``n_obs`` slots (a task observing fewer has zeroed the rest,
+    as in the scalar loop, where ``obs`` is a view of the workspace).
+    """
+    for i in range(len(obs)):
+        W[at + np.uint64(i) * L] = obs[i]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -196,8 +207,7 @@ def start_lanes(g, jobs, table, s, nl, lb, lg):
         task_observe(lb.okind[k], p, state[k], table.noise[e, 0], obs)
         if lb.noisy[k]:
             add_obs_noise(p, table.obs_noise[e, 0, 0], table.obs_noise[e, 0, 1], obs)
-        W[u_obs + np.uint64(k)] = obs[0]
-        W[u_obs + L + np.uint64(k)] = obs[1]
+        _write_obs(W, obs, u_obs + np.uint64(k), L)
         lb.total[k] = 0.0
         lb.n_team[k] = 0
         lb.n_ins[k] = 0
@@ -242,9 +252,7 @@ def step_lanes(g, jobs, table, out, lb, n_live, t):
         task_observe(lb.okind[lane], p, state[lane], table.noise[e, t], obs)
         if lb.noisy[lane]:
             add_obs_noise(p, table.obs_noise[e, t, 0], table.obs_noise[e, t, 1], obs)
-        u_l = np.uint64(lane)
-        W[u_obs + u_l] = obs[0]
-        W[u_obs + L + u_l] = obs[1]
+        _write_obs(W, obs, u_obs + np.uint64(lane), L)
         live[m] = lane
         m += 1
     return m

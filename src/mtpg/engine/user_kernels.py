@@ -7,8 +7,8 @@ registered one, and with the set's state width. The loop's code, and so every de
 is the same function's: only the names it calls resolve elsewhere. The copies are
 compiled on first use in each process (a few seconds) and kept for the process.
 
-The lane engine (:mod:`mtpg.engine.lanes`) is compiled again the same way; it reads two
-inputs, so it plays a set whose graphs observe two inputs, and the scalar loop any other.
+The lane engine (:mod:`mtpg.engine.lanes`) is compiled again the same way; it reads the
+layout's ``n_obs`` inputs, so it plays every set, whatever its tasks observe.
 """
 
 from __future__ import annotations

@@ -374,9 +374,9 @@ HAND_MUTANTS: tuple[HandMutant, ...] = (
     # the production decision kernel (bug classes: wrong winner, memory, output)
     HandMutant(
         "kernel-tie-to-later-program",
-        "src/mtpg/engine/episode_kernels.py",
-        "(best_p < 0 or bid > best)",
-        "(best_p < 0 or bid >= best)",
+        "src/mtpg/engine/bid_rule.py",
+        "marks[at] != stamp) and bid > best",
+        "marks[at] != stamp) and bid >= best",
         _ENGINE,
     ),
     HandMutant(

@@ -338,3 +338,41 @@ def test_the_authors_sentence_and_the_verdict_on_the_paper_s_claims():
         "interface (TPG-authors). Z: hold with neither."
     )
     assert au.base("Pendulum[max_steps=300]") == "Pendulum"
+
+
+def test_the_complete_answer_is_a_headline_and_three_sentences_one_per_kind_of_claim():
+    from types import SimpleNamespace as Run
+
+    import numpy as np
+
+    from mtpg.analysis.results import answer as an
+    from mtpg.analysis.results import authors_section as au
+
+    tpg = [[0.5, 0.4, 0.2]] * 4
+    robust = [[0.95, 0.4, 0.7], [0.92, 0.3, 0.8], [0.99, 0.95, 0.65], [0.9, 0.5, 0.1]]
+    c = _comparison(tpg, robust)
+    scores = [[0.9, 0.7, 0.6], [1.0, 0.65, 0.8], [0.95, 0.62, 0.7], [0.8, 0.5, 0.9], [1, 1, 0.3]]
+    runs = [Run(name=f"TPG-authors-seed{i + 1}") for i in range(5)]
+    norm = {r.name: dict(zip("ABC", row, strict=True)) for r, row in zip(runs, scores, strict=True)}
+    a = au.Authors(runs, runs, 1000, norm, norm, np.array(scores))
+    [text] = an.three_groups(c, a)
+    assert text.startswith("**Does it reproduce the paper? In part.** With the paper's text,")
+    body = text.split("**", 2)[2]
+    assert body.count(". ") == 2 and body.endswith(".")  # three sentences
+    assert "0 of 4 TPG runs and 1 of 4 TPG-robust runs" in text
+    assert "in 2 of 3 tasks (the paper's best run: 4 of 6)" in text
+    assert "(TPG-authors), 3 of 5 runs reach 0.6 in all six tasks and the IQM is" in text
+    assert "P(TPG-authors > TPG-robust) = " in text
+    assert "0 of the 13 runs reach 0.9 of their group's best single-task champion" in text
+    assert text.endswith("and B and C are among the two weakest tasks of every group.")
+    # a task among the two weakest of only some groups is not named
+    assert an.weakest(c.estimates, ["A", "B", "C"]) == ["B", "C"]
+    per_task = c.estimates["TPG-robust"][0]  # B and C its lowest; reversed: A and B
+    both = {"x": (per_task, None), "y": (per_task[::-1], None)}
+    assert an.weakest(both, ["A", "B", "C"]) == ["B"]
+    # the headline follows the claims' verdict
+    assert an.headline({"text": ["x"], "code": [], "neither": []}) == "Yes"
+    assert an.headline({"text": ["x"], "code": ["y"], "neither": []}) == (
+        "Only with its code's interface"
+    )
+    assert an.headline({"text": [], "code": [], "neither": ["z"]}) == "No"

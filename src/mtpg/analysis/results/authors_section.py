@@ -121,17 +121,27 @@ def answer_sentence(a: Authors) -> str:
     )
 
 
-def verdict(rows: list[list[str]]) -> str:
-    """Which claims hold with the paper's text, which only with its code's, which with neither.
+def claim_kinds(rows: list[list[str]]) -> dict[str, list[str]]:
+    """The claims sorted: holding with the paper's text, only with its code's, with neither.
 
     Args:
-        rows: :func:`_claims`' rows (claim, TPG, TPG-robust, TPG-authors).
+        rows: :func:`claims`' rows (claim, TPG, TPG-robust, TPG-authors).
     """
     kinds: dict[str, list[str]] = {"text": [], "code": [], "neither": []}
     for claim, tpg, robust, authors in rows:
         text = "holds" in (tpg.split(": ")[1], robust.split(": ")[1])
         code = authors.endswith(": holds")
         kinds["text" if text else "code" if code else "neither"].append(claim.split(" (")[0])
+    return kinds
+
+
+def verdict(rows: list[list[str]]) -> str:
+    """Which claims hold with the paper's text, which only with its code's, which with neither.
+
+    Args:
+        rows: :func:`claims`' rows (claim, TPG, TPG-robust, TPG-authors).
+    """
+    kinds = claim_kinds(rows)
     said = {
         "text": "hold with the paper's text (TPG or TPG-robust)",
         "code": "hold only with its code's interface (TPG-authors)",
@@ -141,7 +151,7 @@ def verdict(rows: list[list[str]]) -> str:
     return ". ".join(p[0].upper() + p[1:] for p in parts) + "."
 
 
-def _claims(c, a: Authors) -> list[list[str]]:
+def claims(c, a: Authors) -> list[list[str]]:
     """The paper's claims, and how many runs of each group meet them."""
 
     def rate(hit: int, n: int, paper: float) -> str:
@@ -274,7 +284,7 @@ def section(c, a: Authors, probes: dict, target: int) -> list[str]:
         "",
     ]
     best = a.best
-    claims = _claims(c, a)
+    rows = claims(c, a)
     lines += [
         f"Best TPG-authors run: **{best.name}**: "
         + ", ".join(f"{t} {a.norm[best.name][t]:.2f}" for t in tasks)
@@ -292,10 +302,10 @@ def section(c, a: Authors, probes: dict, target: int) -> list[str]:
                 "TPG-robust: its text, episodes redrawn",
                 "TPG-authors: its code's interface",
             ],
-            claims,
+            rows,
         ),
         "",
-        verdict(claims) + ("" if a.complete else f" (TPG-authors on {n} of {SEEDS} runs so far.)"),
+        verdict(rows) + ("" if a.complete else f" (TPG-authors on {n} of {SEEDS} runs so far.)"),
         "",
     ]
     head, rrows, agree, cells = rescore_rows(a.runs)

@@ -21,6 +21,7 @@ import sys
 import warnings
 from pathlib import Path
 
+from mtpg.analysis.results.answer import three_groups
 from mtpg.analysis.results.authors_section import answer_sentence, gather, is_authors
 from mtpg.analysis.results.authors_section import section as authors_section
 from mtpg.analysis.results.robust_section import answer, compare, is_robust
@@ -197,7 +198,9 @@ def build(results: Path, analyze: bool = True, probe: bool = True, out: Path | N
     three = gather(authors, list(tasks), TARGET) if authors and comparison else None
     if comparison is not None and comparison.complete:
         said = answer(comparison)
-        if three is not None:
+        if three is not None and three.complete:
+            said = three_groups(comparison, three)
+        elif three is not None:
             said[-1] += " " + answer_sentence(three)
         lines += [*said, ""]
     lines += ["## Status", ""]

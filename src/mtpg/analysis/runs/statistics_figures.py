@@ -68,10 +68,13 @@ def aggregate(
                 capsize=3,
                 lw=1,
             )
-        for x, v in zip(xs, vals, strict=True):
+        # each value above its interval's top (below its bottom when negative), so that
+        # the error bar does not cross the number
+        tops = np.where(has, np.where(vals >= 0, np.fmax(hi, vals), np.fmin(lo, vals)), vals)
+        for x, v, top in zip(xs, vals, tops, strict=True):
             ax.annotate(
                 f"{v:.2f}",
-                (x, v),
+                (x, top),
                 textcoords="offset points",
                 xytext=(0, 3 if v >= 0 else -9),
                 ha="center",

@@ -158,6 +158,7 @@ def check_training_fits(config: Any, available: int | None = None) -> dict[str, 
     Raises:
         BudgetError: With the estimate, its largest part and what is available.
     """
+    check_continuous_fits(config)
     est = training_estimate(config)
     if est["decisions"] > MAX_DECISIONS_PER_GENERATION:
         raise BudgetError(
@@ -175,6 +176,26 @@ def check_training_fits(config: Any, available: int | None = None) -> dict[str, 
             f"{gib(available)} available; reduce {_CULPRITS[largest]}"
         )
     return est
+
+
+def check_continuous_fits(config: Any) -> None:
+    """Refuses tasks with more continuous outputs than a memory bank has registers.
+
+    Continuous dimension ``j`` is ``m[j]`` of the deciding program's bank, so a run's
+    tasks may take at most ``program.n_memory`` of them.
+
+    Raises:
+        BudgetError: Naming the task and both sizes.
+    """
+    table = config.evaluation.task_table()
+    n_memory = config.program.n_memory
+    for spec in table.specs:
+        n = getattr(spec, "n_continuous", 1)
+        if n > n_memory:
+            raise BudgetError(
+                f"evaluation.tasks: {spec.name} takes {n} continuous outputs (m[0..{n})), "
+                f"more than the {n_memory} registers of a memory bank; raise program.n_memory"
+            )
 
 
 def check_evaluation_fits(n_episodes: int, max_steps: int, available: int | None = None) -> None:

@@ -25,8 +25,9 @@ for a Gymnasium task (``gym:ID``) the environment's raw observation, scaled as i
 (:mod:`mtpg.envs.specs.gym_task`), and its own action; for one of the registered tasks the
 observation of its ``mtpg/<Task>-v0`` environment (two inputs in [-1, 1]) and the paper's
 pair ``(a_d, array([a_c]))``; for a compiled task (``module:ATTR``) what its ``observe``
-writes and the pair ``(a_d, array([m0]))``, ``a_d`` in its ``n_actions`` and ``m0`` the raw
-memory value its ``step`` gets clipped to its bound.
+writes and the pair ``(a_d, array([m0, ...]))``, ``a_d`` in its ``n_actions`` and the array
+the raw memory values ``m[0..n)`` of its ``n_continuous`` dimensions (``m[0]`` alone for a
+task of one or none), which its ``step`` gets made finite and clipped to its bound.
 """
 
 from __future__ import annotations
@@ -64,7 +65,8 @@ class Policy:
         self._gym: GymTask | None = spec if isinstance(spec, GymTask) else None
         #: A compiled task's discrete actions (its a_d is folded onto them), else 0.
         self._fold = spec.n_actions if isinstance(spec, CompiledTask) else 0
-        n_cont = self._gym.n_continuous if self._gym else 1
+        # a compiled task's a_c holds its n_continuous dimensions m[0..n) (m[0] at least)
+        n_cont = self._gym.n_continuous if self._gym else max(getattr(spec, "n_continuous", 1), 1)
         cp = compile_population(population, no_memory=no_memory)
         self.root = int(root)
         self._live = LiveDecider(cp, np.array([cp.team_index(root)]), n_continuous=n_cont)

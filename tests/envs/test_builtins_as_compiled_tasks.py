@@ -61,7 +61,7 @@ def _play(reset, observe, step, table, task, start, noise, a_d, a_c, base):
 
 def test_each_steps_as_the_registered_dispatch_action_for_action():
     table = TaskTable.from_names(COMPILED)
-    user = generate(table.user, table.ids[0])
+    user = generate(table.user, table.ids[0])[:3]
     builtin = (dispatch.env_reset, dispatch.task_observe, dispatch.task_step)
     rng = np.random.default_rng(54)
     seeds = np.arange(700, 704)

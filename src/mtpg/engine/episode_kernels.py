@@ -48,6 +48,7 @@ from mtpg.envs.dynamics.dispatch import (
     add_obs_noise,
     env_reset,
     observe_kind,
+    task_continuous,
     task_observe,
     task_step,
 )
@@ -290,11 +291,14 @@ def run_jobs_queue(next_block, block, jobs, table, out, g, rec=None):
             while True:
                 if rec is not None:
                     record_observation(rec, t, obs)
-                a_d, a_c = decide(g, buf, root, stamp, j, rec)
+                a_d, off = decide_bank(g, buf, root, stamp, j, rec)
+                a_c = buf.W[np.uint64(off)]
                 stamp += 1
                 if rec is not None:
                     record_decision(rec, t, a_d, a_c, buf, g, j)
-                # The one task dispatch: a step kernel, called without reference counts.
+                # The one task dispatch: step kernels, called without reference counts
+                # (task_continuous hands m[1..] to a task of several continuous outputs).
+                task_continuous(kind, p, state, buf.W, np.uint64(off), np.uint64(1))
                 reward, terminated, truncated = task_step(kind, p, state, a_d, a_c)
                 total += reward
                 t += 1

@@ -172,7 +172,9 @@ def _follow(lg, lb, n, team_ins, n_pend):
         act = row[P_ACT]
         if act < 0:
             lb.a_d[lane] = -1 - act
-            lb.a_c[lane] = W[np.uint64(row[P_BANK]) + lane]
+            at = np.uint64(row[P_BANK]) + lane  # m[0] of the bank; m[j] at at + j * L
+            lb.a_off[lane] = at
+            lb.a_c[lane] = W[at]
         else:
             pend_team[n_pend] = act
             pend_lane[n_pend] = np.int64(lane)

@@ -38,6 +38,7 @@ from mtpg.envs.dynamics.dispatch import (
     add_obs_noise,
     env_reset,
     observe_kind,
+    task_continuous,
     task_observe,
     task_step,
 )
@@ -80,6 +81,8 @@ class Lanes(NamedTuple):
         best_p: int64: the program row of that bid.
         a_d: int64: each lane's atomic action of the decision.
         a_c: float64: each lane's continuous action of the decision.
+        a_off: uint64: each lane's index in ``W`` of ``m[0]`` of the decision's bank
+            (``m[j]`` at ``a_off + j * lanes``).
         pend_team: int64: the local team of each pending lane of the decision.
         pend_lane: int64: the pending lanes.
         grp: uint64: the lanes of the group being run.
@@ -105,6 +108,7 @@ class Lanes(NamedTuple):
     best_p: np.ndarray
     a_d: np.ndarray
     a_c: np.ndarray
+    a_off: np.ndarray
     pend_team: np.ndarray
     pend_lane: np.ndarray
     grp: np.ndarray
@@ -150,6 +154,7 @@ def lane_buffers(g, lanes) -> Lanes:
         best_p=np.zeros(lanes, dtype=np.int64),
         a_d=np.zeros(lanes, dtype=np.int64),
         a_c=np.zeros(lanes),
+        a_off=np.zeros(lanes, dtype=np.uint64),
         pend_team=np.zeros(lanes, dtype=np.int64),
         pend_lane=np.zeros(lanes, dtype=np.int64),
         grp=np.zeros(lanes, dtype=np.uint64),
@@ -239,6 +244,7 @@ def step_lanes(g, jobs, table, out, lb, n_live, t):
         j = lb.job[lane]
         e = jobs.episodes[j]
         p = table.params[table.tasks[e]]
+        task_continuous(lb.kind[lane], p, state[lane], W, lb.a_off[lane], L)
         reward, terminated, truncated = task_step(
             lb.kind[lane], p, state[lane], lb.a_d[lane], lb.a_c[lane]
         )

@@ -63,8 +63,13 @@ def kernels(tasks: tuple[CompiledTask, ...], first_id: int, width: int) -> tuple
         ``(run_jobs_queue, run_jobs_parallel, run_lanes_queue, run_lanes_parallel)`` with
         the signatures of :mod:`mtpg.engine.episode_kernels` and :mod:`mtpg.engine.lanes`.
     """
-    reset, observe, step = generate(tasks, first_id)
-    dispatch = {"env_reset": reset, "task_observe": observe, "task_step": step}
+    reset, observe, step, continuous = generate(tasks, first_id)
+    dispatch = {
+        "env_reset": reset,
+        "task_observe": observe,
+        "task_step": step,
+        "task_continuous": continuous,
+    }
     buffers = _rebound(episode_kernels.thread_buffers, {"STATE_SIZE": width})
     queue = _rebound(
         episode_kernels.run_jobs_queue, {**dispatch, "thread_buffers": buffers}, nogil=True
@@ -74,7 +79,10 @@ def kernels(tasks: tuple[CompiledTask, ...], first_id: int, width: int) -> tuple
         "lane_buffers": _rebound(lanes.lane_buffers, {"STATE_SIZE": width}),
         "start_lanes": _rebound(lanes.start_lanes, {"env_reset": reset, "task_observe": observe}),
     }
-    step_lanes = _rebound(lanes.step_lanes, {"task_observe": observe, "task_step": step})
+    step_lanes = _rebound(
+        lanes.step_lanes,
+        {"task_observe": observe, "task_step": step, "task_continuous": continuous},
+    )
     lane_steps["play_block"] = _rebound(lanes.play_block, {"step_lanes": step_lanes})
     lane_queue = _rebound(lanes.run_lanes_queue, lane_steps, nogil=True)
     lane_parallel = _rebound(

@@ -201,6 +201,10 @@ void mtpg_reset(void);
  * continuous output (m[0] of the winning program's memory bank) in *a_c. */
 void mtpg_act(const double obs[{graph.layout.n_obs}], int *a_d, double *a_c);
 
+/* After mtpg_act: m[0..n) of the winning program's bank in out[0..n) (n at most
+ * MTPG_N_MEMORY), a task's continuous dimensions j = 0..n-1; out[0] equals *a_c. */
+void mtpg_continuous(int n, double *out);
+
 #ifdef MTPG_TRACE
 /* Teams visited by the last decision (ids of the graph file), in order. */
 extern int mtpg_trace_n;
@@ -233,6 +237,8 @@ def source_text(graph: ExportGraph, name: str) -> str:
         "static const int mtpg_team_ids[MTPG_N_TEAMS] = {"
         + ", ".join(str(t) for t in graph.team_ids)
         + "};\n#endif",
+        "/* The bank of the last decision: its m[0..n) are a task's n continuous outputs. */\n"
+        "static int mtpg_last_bank = 0;",
         "static void mtpg_zero_bank(double *m)\n{\n    int j;\n"
         "    for (j = 0; j < MTPG_N_MEMORY; j++)\n        m[j] = 0.0;\n}",
     ]
@@ -260,6 +266,11 @@ def source_text(graph: ExportGraph, name: str) -> str:
         "        mtpg_zero_bank(mtpg_mem[b]);\n}"
     )
     parts.append(_act_function(graph))
+    parts.append(
+        "void mtpg_continuous(int n, double *out)\n{\n    int j;\n"
+        "    for (j = 0; j < n && j < MTPG_N_MEMORY; j++)\n"
+        "        out[j] = mtpg_mem[mtpg_last_bank][j];\n}"
+    )
     return "\n\n".join(parts) + "\n"
 
 
@@ -297,6 +308,7 @@ def _act_function(graph: ExportGraph) -> str:
             "        if (next < 0) {",
             "            *a_d = -1 - next;",
             "            *a_c = mtpg_mem[bank][0];",
+            "            mtpg_last_bank = bank;",
             "            return;",
             "        }",
             "        team = next;",

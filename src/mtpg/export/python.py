@@ -137,7 +137,8 @@ def module_text(graph: ExportGraph) -> str:
 
 Usage: call reset() at the start of every episode (it zeroes all memory banks), then
 act(obs) once per step with the {inputs}; it returns (a_d, a_c): the discrete
-action ({actions}) and the continuous output (m[0] of the winning program's memory bank).
+action ({actions}) and the continuous output (m[0] of the winning program's memory bank);
+continuous(n) then gives that bank's m[0..n), a task's n continuous dimensions.
 {memory}.
 Needs only the standard library; the results equal the mtpg engine's bit for bit (IEEE
 doubles, same C library math functions).
@@ -149,7 +150,7 @@ import math''',
         f"{tuple(graph.team_ids)!r}\n#: Memory banks (source ids {list(graph.bank_ids)}).\n"
         f"_MEM = [[0.0] * {n_mem} for _ in range({len(graph.bank_ids)})]\n"
         f"_ZEROS = [0.0] * {n_mem}\n#: Team ids visited by the last decision, in order.\n"
-        "last_teams = []",
+        "last_teams = []\n#: The bank of the last decision.\n_LAST = [0]",
         'def reset():\n    """Zeroes every memory bank: call at the start of every episode."""\n'
         "    for bank in _MEM:\n        bank[:] = _ZEROS",
         "def _clamp(v):\n    if v > BIG:\n        return BIG\n"
@@ -171,8 +172,14 @@ import math''',
         "        last_teams.append(TEAM_IDS[team])\n"
         "        nxt, bank = _TEAMS[team](s, visited)\n"
         "        if nxt < 0:\n"
+        "            _LAST[0] = bank\n"
         "            return -1 - nxt, _MEM[bank][0]\n"
         "        team = nxt"
+    )
+    parts.append(
+        "def continuous(n):\n"
+        '    """m[0..n) of the bank of the last decision: n continuous outputs."""\n'
+        f"    return tuple(_MEM[_LAST[0]][:min(n, {n_mem})])"
     )
     return "\n\n\n".join(parts) + "\n"
 

@@ -275,6 +275,30 @@ def task_step(
     return reward, terminated, truncated
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def task_continuous(
+    kind: int, p: np.ndarray, state: np.ndarray, W: np.ndarray, off: int, stride: int
+) -> None:
+    """Hands a task the continuous outputs past ``m[0]``: none for the registered tasks.
+
+    The engine calls it before every :func:`task_step`, with the workspace ``W`` and the
+    index ``off`` of ``m[0]`` of the deciding program's bank (``m[j]`` at
+    ``off + j * stride``). The registered tasks read one continuous action, ``a_c = m[0]``,
+    so this one does nothing and compiles away (it is inlined); the dispatch generated for
+    compiled tasks of several continuous dimensions copies ``m[0..n)`` into the task's
+    state array, where its ``step`` reads them (:mod:`mtpg.envs.dynamics.user_dispatch`).
+
+    Args:
+        kind: The row's base task id.
+        p: The parameter row.
+        state: The state array.
+        W: The workspace holding the bank.
+        off: The index of ``m[0]`` in ``W``.
+        stride: The distance between ``m[j]`` and ``m[j + 1]`` in ``W``.
+    """
+    return None
+
+
 @njit(cache=True, error_model="numpy")
 def env_step(
     task: int, params: np.ndarray, state: np.ndarray, a_d: int, a_c: float

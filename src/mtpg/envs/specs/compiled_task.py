@@ -24,7 +24,10 @@ in an importable module, naming three functions and the task's sizes::
   episode's seed, for tasks that observe noise.
 - ``a_d`` is in ``0..n_actions-1`` (0 when the task has no discrete action); ``a_c`` is
   ``m[0]`` of the final program's memory bank, a non-finite value made 0 and then clipped
-  to ``[-p[1], p[1]]`` (0 when the task has no continuous action).
+  to ``[-p[1], p[1]]`` (0 when the task has no continuous action). A task of
+  ``n_continuous = n > 1`` dimensions gets ``a_c`` as a float64 array of ``n`` values,
+  ``a_c[j]`` being ``m[j]``, each made finite and clipped the same way (at most
+  ``program.n_memory`` dimensions, 8 by default).
 - The engine counts the steps: an episode ends when ``step`` returns ``terminated`` or after
   ``max_steps`` steps (truncated).
 - Episode seeds as for the registered tasks (test episode ``k``: seed ``1_000_000 + k``):
@@ -57,6 +60,9 @@ from mtpg.envs.specs.param_table import N_TASK_COLUMNS
 MAX_PARAMS = N_TASK_COLUMNS - 2
 #: Most state slots of a compiled task.
 MAX_STATE = 64
+#: Most continuous dimensions of a compiled task (a run also needs as many memory
+#: registers per bank, ``program.n_memory``: :func:`mtpg.limits.check_continuous_fits`).
+MAX_CONTINUOUS = 64
 
 
 class CompiledTaskError(ValueError):
@@ -80,7 +86,8 @@ class CompiledTask:
         sample_start: ``sample_start(rng) -> array of state_dim floats``, plain Python.
         n_obs: Observed inputs (1 or more).
         n_actions: Discrete actions (0: the task reads no discrete action).
-        n_continuous: Continuous action dimensions (0 or 1: ``a_c`` is ``m[0]``).
+        n_continuous: Continuous action dimensions: 0, 1 (``a_c`` is the float ``m[0]``)
+            or more (``a_c`` is an array, ``a_c[j] = m[j]``).
         state_dim: Slots of the task's state.
         max_steps: The time limit in steps.
         params: The task's constants, ``p[2:]`` (at most :data:`MAX_PARAMS`).
@@ -110,7 +117,11 @@ class CompiledTask:
         checks = (
             (self.n_obs >= 1, "n_obs", "must be >= 1"),
             (self.n_actions >= 0, "n_actions", "must be >= 0"),
-            (self.n_continuous in (0, 1), "n_continuous", "must be 0 or 1"),
+            (
+                0 <= self.n_continuous <= MAX_CONTINUOUS,
+                "n_continuous",
+                f"must be 0..{MAX_CONTINUOUS}",
+            ),
             (self.n_actions + self.n_continuous > 0, "n_actions", "or n_continuous must be > 0"),
             (1 <= self.state_dim <= MAX_STATE, "state_dim", f"must be 1..{MAX_STATE}"),
             (self.max_steps >= 1, "max_steps", "must be >= 1"),
@@ -136,6 +147,15 @@ class CompiledTask:
     def continuous(self) -> bool:
         """Whether the task reads the continuous action."""
         return self.n_continuous > 0
+
+    @property
+    def slots(self) -> int:
+        """Slots the task takes in the engine's state array.
+
+        Its state, then its continuous action when it has several dimensions
+        (:mod:`mtpg.envs.dynamics.user_dispatch`).
+        """
+        return self.state_dim + (self.n_continuous if self.n_continuous > 1 else 0)
 
     @property
     def bound(self) -> float:

@@ -43,7 +43,7 @@ def sample_start(task: int, rng: np.random.Generator, table: TaskTable = REGISTE
 
 def state_width(table: TaskTable) -> int:
     """Slots of a state array of ``table``'s tasks: ``STATE_SIZE``, more with compiled tasks."""
-    return STATE_SIZE + max((t.state_dim for t in table.user), default=0)
+    return STATE_SIZE + max((t.slots for t in table.user), default=0)
 
 
 def make_episodes(

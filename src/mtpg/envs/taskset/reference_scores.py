@@ -201,17 +201,22 @@ def measure_compiled_random(name: str, n: int = N_COMPILED_RANDOM_EPISODES) -> t
     """The random agent's (mean, standard deviation) on a compiled task, measured once.
 
     The registered tasks' convention (module docstring) over ``n`` episodes, with ``a_d``
-    uniform on the task's ``n_actions`` actions; the episodes step through the task's
-    generated dispatch from Python. A pure function of the name (the task's module).
+    uniform on the task's ``n_actions`` actions (and each continuous dimension uniform on
+    its bound); the episodes step through the task's generated dispatch from Python. A
+    pure function of the name (the task's module).
     """
     table = TaskTable.from_names([name])
     task = table.ids[0]
     spec = table.spec(task)
-    reset, observe, step = generate(table.user, task)
+    reset, observe, step, continuous = generate(table.user, task)
     rng = np.random.default_rng(RANDOM_ACTION_SEED)
     starts, noise = make_episodes(np.full(n, task), RANDOM_SEED_BASE + np.arange(n), table)
     a_d = rng.integers(0, max(spec.n_actions, 1), (n, spec.max_steps))
     a_c = rng.uniform(-spec.bound, spec.bound, (n, spec.max_steps))
+    # dimensions past the first, drawn after (one-dimensional tasks keep their draws)
+    more = rng.uniform(-spec.bound, spec.bound, (n, spec.max_steps, max(spec.n_continuous, 1)))
+    more[:, :, 0] = a_c
+    zero, one = np.uint64(0), np.uint64(1)
     p = table.params[task]
     state = np.zeros(starts.shape[1])
     obs = np.zeros(spec.n_obs)
@@ -220,6 +225,8 @@ def measure_compiled_random(name: str, n: int = N_COMPILED_RANDOM_EPISODES) -> t
         reset(task, table.params, starts[i], state)
         observe(task, p, state, noise[i, 0], obs)
         for t in range(spec.max_steps):
+            if spec.n_continuous > 1:
+                continuous(task, p, state, more[i, t], zero, one)
             reward, terminated, truncated = step(task, p, state, a_d[i, t], a_c[i, t])
             returns[i] += reward
             if terminated or truncated:

@@ -142,7 +142,7 @@ def test_a_two_dimensional_task_trains_acts_and_exports(tmp_path, user_module):
 
     run_dir = tmp_path / "run"
     train = call(
-        user_module, "train", *SMALL, "--tasks", TASK, "--generations", "4", "--out", str(run_dir)
+        user_module, "train", *SMALL, "--tasks", TASK, "--generations", "2", "--out", str(run_dir)
     )
     assert train.returncode == 0, train.stderr
     done = call(user_module, "evaluate", str(run_dir), "--episodes", "5", "--json")
